@@ -1,0 +1,128 @@
+#include "articula/cli/command.hpp"
+
+#include <iostream>
+#include <new>
+#include <thread>
+
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+#include "articula/core/provenance.hpp"
+#include "articula/core/version.hpp"
+
+namespace articula::cli {
+
+int CommonOptions::threadCount() const {
+  if (threads > 0) return threads;
+  unsigned n = std::thread::hardware_concurrency();
+  return n ? static_cast<int>(n) : 1;
+}
+
+void addCommonOptions(CLI::App& app, CommonOptions& common) {
+  app.set_version_flag("--version", versionString());
+  app.set_config("--config", "", "Read option values from a TOML/INI file (CLI11 format)");
+  auto* quiet = app.add_flag_callback("-q,--quiet", [&common] { common.verbosity = 0; }, "Print errors only");
+  app.add_flag_callback("-v,--verbose", [&common] { common.verbosity = 2; }, "Print debug messages")
+      ->excludes(quiet);
+  app.add_option("--seed", common.seed, "Seed of every random choice (same seed, same output)")
+      ->capture_default_str();
+  app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_flag("--json", common.json, "Print a machine-readable summary on stdout");
+  app.add_flag("--force", common.force, "Overwrite existing outputs");
+}
+
+namespace {
+
+// Maps every exception to the documented exit codes (0/1/2/3).
+template <class Body>
+int guarded(Body&& body) {
+  try {
+    return body();
+  } catch (const Error& e) {
+    log::error(e.what());
+    return static_cast<int>(e.code());
+  } catch (const std::bad_alloc&) {
+    log::error("out of memory");
+    return static_cast<int>(ExitCode::ProcessingFailed);
+  } catch (const std::exception& e) {
+    log::error(std::string("unexpected failure: ") + e.what());
+    return static_cast<int>(ExitCode::ProcessingFailed);
+  }
+}
+
+void applyCommon(const CommonOptions& common) {
+  log::setLevel(static_cast<log::Level>(common.verbosity));
+  if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer, found " + std::to_string(common.seed));
+}
+
+// CLI11 reports usage errors itself; normalise its exit codes to ours.
+int parseFailure(CLI::App& app, const CLI::ParseError& e) {
+  int rc = app.exit(e);
+  return rc == 0 ? 0 : static_cast<int>(ExitCode::UsageError);
+}
+
+void describe(CLI::App& app, const Command& command) {
+  app.description(command.description());
+  app.footer("Example:\n  " + command.example() +
+             "\n\nExit codes: 0 success, 1 processing failed, 2 usage error, 3 invalid input.");
+}
+
+}  // namespace
+
+int runCommandMain(int argc, char** argv, std::unique_ptr<Command> command) {
+  setCommandLine(argc, argv);
+  CLI::App app;
+  app.name("articula-" + command->name());
+  describe(app, *command);
+  CommonOptions common;
+  addCommonOptions(app, common);
+  command->declare(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return parseFailure(app, e);
+  }
+  return guarded([&] {
+    applyCommon(common);
+    return command->run(common);
+  });
+}
+
+int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> commands) {
+  setCommandLine(argc, argv);
+  CLI::App app{"articula: shape analysis of spheroidal joints from CT, and exact contact detection "
+               "between smooth convex surfaces. Coordinates are LPS millimetres."};
+  app.name("articula");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", versionString());
+  app.footer("Run 'articula <command> --help' for a command's options.\n"
+             "Exit codes: 0 success, 1 processing failed, 2 usage error, 3 invalid input.");
+  std::vector<CommonOptions> common(commands.size());
+  std::vector<CLI::App*> subs;
+  for (size_t i = 0; i < commands.size(); ++i) {
+    CLI::App* sub = app.add_subcommand(commands[i]->name(), commands[i]->description());
+    describe(*sub, *commands[i]);
+    addCommonOptions(*sub, common[i]);
+    commands[i]->declare(*sub);
+    subs.push_back(sub);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return parseFailure(app, e);
+  }
+  for (size_t i = 0; i < commands.size(); ++i) {
+    if (subs[i]->parsed()) {
+      return guarded([&] {
+        applyCommon(common[i]);
+        return commands[i]->run(common[i]);
+      });
+    }
+  }
+  return static_cast<int>(ExitCode::UsageError);
+}
+
+void printJson(const nlohmann::json& summary) { std::cout << summary.dump(2) << std::endl; }
+
+}  // namespace articula::cli

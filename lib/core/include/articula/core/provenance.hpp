@@ -1,0 +1,31 @@
+#pragma once
+// Provenance that every result file carries: version, commit, command line,
+// parameters, seed and the SHA-256 of every input.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace articula {
+
+/// Lower-case hex SHA-256 of a file's bytes; throws InputError if unreadable.
+std::string sha256File(const std::filesystem::path& path);
+/// Lower-case hex SHA-256 of a string.
+std::string sha256String(const std::string& bytes);
+
+/// The command line of this process, as one shell-like string.
+std::string commandLine();
+void setCommandLine(int argc, const char* const* argv);
+
+struct Provenance {
+  nlohmann::json parameters = nlohmann::json::object();
+  std::vector<std::filesystem::path> inputs;  // hashed into "inputs"
+  long long seed = -1;                        // -1: no randomness involved
+};
+
+/// {"articula_version", "git_commit", "command", "seed", "parameters",
+///  "inputs": [{"path","sha256"}], "coordinate_system": "LPS", "units": "mm"}
+nlohmann::json provenanceJson(const Provenance& p);
+
+}  // namespace articula

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package articula builds, tests and benchmarks with.
+# Non-interactive and idempotent: packages already present are skipped, so a
+# second run makes no network request.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake git pkg-config libssl-dev
+  libinsighttoolkit5-dev libvtk9-dev libcgal-dev libeigen3-dev
+  libnlopt-cxx-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
+  # measured peers (contact benchmarks) and the multibody engine
+  libsimbody-dev libfcl-dev libccd-dev libbullet-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: done"
