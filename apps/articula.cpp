@@ -1,10 +1,6 @@
-// The driver: `articula <command> ...`, one subcommand per command file.
-#include <vector>
-
-#include "commands.hpp"
+// The driver: `articula <command> ...` for every registered command.
+#include "articula/cli/command.hpp"
 
 int main(int argc, char** argv) {
-  std::vector<std::unique_ptr<articula::cli::Command>> commands;
-  commands.push_back(articula::apps::makeSurfaceCommand());
-  return articula::cli::runDriverMain(argc, argv, std::move(commands));
+  return articula::cli::runDriverMain(argc, argv, articula::cli::createAllCommands());
 }

@@ -6,13 +6,13 @@
 #include <iomanip>
 #include <limits>
 
+#include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/geometry/curvature.hpp"
 #include "articula/geometry/surface.hpp"
-#include "commands.hpp"
 
 namespace articula::apps {
 namespace {
@@ -124,8 +124,9 @@ class SurfaceCommand : public cli::Command {
   std::filesystem::path output_;
 };
 
-}  // namespace
 
-std::unique_ptr<cli::Command> makeSurfaceCommand() { return std::make_unique<SurfaceCommand>(); }
+ARTICULA_REGISTER_COMMAND(SurfaceCommand)
+
+}  // namespace
 
 }  // namespace articula::apps

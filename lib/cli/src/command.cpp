@@ -1,6 +1,7 @@
 #include "articula/cli/command.hpp"
 
 #include <iostream>
+#include <map>
 #include <new>
 #include <thread>
 
@@ -30,6 +31,30 @@ void addCommonOptions(CLI::App& app, CommonOptions& common) {
       ->capture_default_str();
   app.add_flag("--json", common.json, "Print a machine-readable summary on stdout");
   app.add_flag("--force", common.force, "Overwrite existing outputs");
+}
+
+namespace {
+std::map<std::string, CommandFactory>& registry() {
+  static std::map<std::string, CommandFactory> commands;
+  return commands;
+}
+}  // namespace
+
+bool registerCommand(const std::string& name, CommandFactory factory) {
+  registry()[name] = factory;
+  return true;
+}
+
+std::unique_ptr<Command> createCommand(const std::string& name) {
+  auto it = registry().find(name);
+  if (it == registry().end()) throw UsageError("unknown command '" + name + "'");
+  return it->second();
+}
+
+std::vector<std::unique_ptr<Command>> createAllCommands() {
+  std::vector<std::unique_ptr<Command>> all;
+  for (const auto& [name, factory] : registry()) all.push_back(factory());
+  return all;
 }
 
 namespace {

@@ -40,6 +40,19 @@ class Command {
   virtual int run(const CommonOptions& common) = 0;
 };
 
+/// Registry of commands (PDAL-style): each apps/<name>.cpp registers its
+/// command once with ARTICULA_REGISTER_COMMAND(Class); the driver lists them.
+using CommandFactory = std::unique_ptr<Command> (*)();
+bool registerCommand(const std::string& name, CommandFactory factory);
+/// A fresh instance of the named command; throws UsageError if unknown.
+std::unique_ptr<Command> createCommand(const std::string& name);
+/// One fresh instance of every registered command, sorted by name.
+std::vector<std::unique_ptr<Command>> createAllCommands();
+
+#define ARTICULA_REGISTER_COMMAND(Class)                                                          \
+  [[maybe_unused]] const bool articula_registered_##Class = ::articula::cli::registerCommand(     \
+      Class().name(), []() -> std::unique_ptr<::articula::cli::Command> { return std::make_unique<Class>(); });
+
 /// Adds the standard options to `app`, bound to `common`.
 void addCommonOptions(CLI::App& app, CommonOptions& common);
 
