@@ -278,7 +278,7 @@ std::vector<double> parseAsciiRecord(const std::string& line, const Element& ele
       continue;
     }
     const double count = next("a list length for property '" + p.name + "'");
-    if (count < 0 || count != static_cast<double>(static_cast<long>(count)))
+    if (count < 0 || count > 1e9 || count != static_cast<double>(static_cast<long>(count)))
       throw fail("a non-negative integer list length", std::to_string(count));
     for (long j = 0; j < static_cast<long>(count); ++j)
       next("item " + std::to_string(j) + " of list '" + p.name + "'");
