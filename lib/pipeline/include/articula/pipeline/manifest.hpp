@@ -1,0 +1,30 @@
+#pragma once
+// Batch manifests: one subject per row, columns `subject,input,joint,side`,
+// then optional per-subject options: a column `seed_point` with value
+// `1,2,3` becomes `--seed-point 1,2,3` for that subject (empty cells add
+// nothing). Relative inputs are resolved from the manifest's folder.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace articula::pipeline {
+
+struct Subject {
+  std::string id;                   // subject column; a safe folder name
+  std::filesystem::path input;      // absolute
+  std::string joint;                // hip | shoulder
+  std::string side;                 // left | right
+  std::vector<std::string> options; // extra command-line arguments
+  int line = 0;                     // line in the manifest
+};
+
+/// Reads and checks a manifest; throws InputError naming the file and line for
+/// a missing column, an empty or duplicated subject id, an id that is not a
+/// safe folder name, or a joint/side outside hip|shoulder / left|right.
+std::vector<Subject> readManifest(const std::filesystem::path& manifest);
+
+/// Problems with a subject's input that would make it fail (missing path,
+/// unreadable, an empty folder, an unknown extension); empty if none.
+std::vector<std::string> checkSubjectInput(const Subject& subject);
+
+}  // namespace articula::pipeline

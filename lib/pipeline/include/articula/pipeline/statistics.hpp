@@ -1,0 +1,33 @@
+#pragma once
+// Statistics of a morphology study: summaries of signed errors, the paired
+// Wilcoxon signed-rank test, and information criteria that weigh the number
+// of parameters beside the fit.
+#include <vector>
+
+namespace articula::pipeline {
+
+struct Summary {
+  int n = 0;
+  double mean = 0.0, sd = 0.0;  // sd with n - 1 (0 when n < 2)
+};
+Summary summarise(const std::vector<double>& values);
+
+struct WilcoxonResult {
+  int n_used = 0;          // pairs with a non-zero difference
+  double w_plus = 0.0;     // sum of the ranks of positive differences x - y
+  double p_value = 1.0;    // two-sided
+  bool exact = false;      // exact permutation distribution (n_used <= 60) or normal approximation
+};
+/// Paired two-sided Wilcoxon signed-rank test of x against y (zero
+/// differences dropped, tied |differences| given their average rank). Exact
+/// for up to 60 non-zero pairs (conditional on the ties); beyond, the normal
+/// approximation with tie and continuity corrections.
+WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vector<double>& y);
+
+/// Gaussian-likelihood information criteria from n residuals with sum of
+/// squares `sse` and k model parameters: AIC = n ln(sse/n) + 2k,
+/// BIC = n ln(sse/n) + k ln(n) (constants dropped: compare within one point set).
+double aic(double sse, int n, int k);
+double bic(double sse, int n, int k);
+
+}  // namespace articula::pipeline

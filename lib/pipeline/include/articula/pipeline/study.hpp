@@ -1,0 +1,25 @@
+#pragma once
+// Study tables gathered from every subject's results.json (written by
+// `articula run`):
+//   study.csv          one row per subject x model: parameters and error statistics
+//   study_summary.csv  per model: mean and sd of RMS across subjects, how often
+//                      it is best (by RMS, AIC, BIC), mean AIC/BIC difference to
+//                      the sphere, and the paired Wilcoxon signed-rank p-value of
+//                      its RMS against the sphere's
+//   study_status.csv   one row per subject: status, exit code, message
+//   study.json         all of the above, with provenance
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "articula/pipeline/batch.hpp"
+
+namespace articula::pipeline {
+
+/// Reads subjects' results and writes the study tables into `study_dir`
+/// (atomically); returns study.json's content.
+nlohmann::json writeStudyTables(const std::filesystem::path& study_dir, const std::vector<Subject>& subjects,
+                                const BatchSummary& batch, const nlohmann::json& provenance);
+
+}  // namespace articula::pipeline

@@ -1,0 +1,178 @@
+#include "articula/pipeline/batch.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <chrono>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "articula/core/atomic_file.hpp"
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+
+extern char** environ;
+
+namespace articula::pipeline {
+
+namespace fs = std::filesystem;
+
+fs::path subjectDir(const fs::path& study_dir, const std::string& id) { return study_dir / "subjects" / id; }
+
+namespace {
+
+// Runs argv with stdout and stderr appended to `log`; returns the exit code
+// (128 + signal when killed by a signal).
+int runProcess(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw ProcessingError("cannot start '" + args[0] + "': " + std::strerror(rc));
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw ProcessingError("waiting for '" + args[0] + "' failed");
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+// The subject's own error message: the last "articula: error:" line of its log.
+std::string errorMessage(const fs::path& log, int exit_code) {
+  std::ifstream in(log);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.rfind("articula: error: ", 0) == 0) last = line.substr(17);
+  if (!last.empty()) return last;
+  if (exit_code > 128) return "killed by signal " + std::to_string(exit_code - 128);
+  return "exited with code " + std::to_string(exit_code) + " (see " + log.string() + ")";
+}
+
+bool finishedEarlier(const fs::path& dir) {
+  std::ifstream in(dir / "status.json");
+  if (!in || !fs::exists(dir / "results.json")) return false;
+  try {
+    const auto status = nlohmann::json::parse(in);
+    return status.value("status", "") == "ok";
+  } catch (const nlohmann::json::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& options) {
+  if (options.jobs < 1) throw UsageError("-j: expected at least 1 job, found " + std::to_string(options.jobs));
+  const auto batch_start = std::chrono::steady_clock::now();
+  BatchSummary summary;
+  summary.outcomes.resize(subjects.size());
+  std::atomic<size_t> next{0};
+  std::mutex log_mutex;
+
+  auto work = [&] {
+    for (size_t i = next++; i < subjects.size(); i = next++) {
+      const Subject& s = subjects[i];
+      SubjectOutcome& out = summary.outcomes[i];
+      out.id = s.id;
+      const fs::path dir = subjectDir(options.study_dir, s.id);
+      if (!options.rerun_finished && finishedEarlier(dir)) {
+        out.status = "ok";
+        out.resumed = true;
+        continue;
+      }
+      fs::create_directories(dir);
+      std::vector<std::string> args = {options.executable.string(), "run", "-i", s.input.string(), "-o",
+                                       dir.string(), "--joint", s.joint, "--side", s.side,
+                                       "--seed", std::to_string(options.seed), "--threads", "1"};
+      args.insert(args.end(), s.options.begin(), s.options.end());
+      args.insert(args.end(), options.extra_args.begin(), options.extra_args.end());
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        out.exit_code = runProcess(args, dir / "run.log");
+      } catch (const Error& e) {
+        out.exit_code = static_cast<int>(e.code());
+        out.message = e.what();
+      }
+      out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      out.status = out.exit_code == 0 ? "ok" : "failed";
+      if (out.exit_code != 0 && out.message.empty()) out.message = errorMessage(dir / "run.log", out.exit_code);
+      std::string command;
+      for (const auto& a : args) command += (command.empty() ? "" : " ") + a;
+      const nlohmann::json status = {{"subject", s.id},         {"status", out.status},
+                                     {"exit_code", out.exit_code}, {"message", out.message},
+                                     {"seconds", out.seconds},  {"command", command},
+                                     {"input", s.input.string()}};
+      writeFileAtomically(dir / "status.json", status.dump(2) + "\n");
+      if (!options.quiet) {
+        std::lock_guard<std::mutex> lock(log_mutex);
+        log::info("subject " + s.id + ": " + out.status +
+                  (out.status == "ok" ? "" : " (exit " + std::to_string(out.exit_code) + "): " + out.message));
+      }
+    }
+  };
+  std::vector<std::thread> workers;
+  const int n_workers = std::min<int>(options.jobs, static_cast<int>(std::max<size_t>(subjects.size(), 1)));
+  for (int w = 0; w < n_workers; ++w) workers.emplace_back(work);
+  for (auto& t : workers) t.join();
+
+  for (const auto& o : summary.outcomes) {
+    if (o.status == "ok") ++summary.succeeded;
+    else ++summary.failed;
+    if (o.resumed) ++summary.resumed;
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_start).count();
+  return summary;
+}
+
+BatchSummary gatherOutcomes(const std::vector<Subject>& subjects, const fs::path& study_dir) {
+  BatchSummary summary;
+  for (const auto& s : subjects) {
+    SubjectOutcome out;
+    out.id = s.id;
+    out.resumed = true;
+    const fs::path dir = subjectDir(study_dir, s.id);
+    std::ifstream in(dir / "status.json");
+    nlohmann::json status;
+    if (in) {
+      try {
+        status = nlohmann::json::parse(in);
+      } catch (const nlohmann::json::exception&) {
+      }
+    }
+    if (status.is_object()) {
+      out.status = status.value("status", "failed");
+      out.exit_code = status.value("exit_code", 1);
+      out.message = status.value("message", "");
+      out.seconds = status.value("seconds", 0.0);
+    } else {
+      const bool done = fs::exists(dir / "results.json");
+      out.status = done ? "ok" : "failed";
+      out.exit_code = done ? 0 : 1;
+      if (!done) out.message = "no results in " + dir.string();
+    }
+    if (out.status == "ok" && !fs::exists(dir / "results.json")) {
+      out.status = "failed";
+      out.message = "status ok but no results.json in " + dir.string();
+    }
+    (out.status == "ok" ? summary.succeeded : summary.failed)++;
+    summary.outcomes.push_back(out);
+  }
+  summary.resumed = static_cast<int>(subjects.size());
+  return summary;
+}
+
+}  // namespace articula::pipeline

@@ -1,0 +1,82 @@
+#include "articula/pipeline/manifest.hpp"
+
+#include <set>
+
+#include "articula/core/error.hpp"
+#include "articula/pipeline/csv.hpp"
+
+namespace articula::pipeline {
+
+namespace fs = std::filesystem;
+
+std::vector<Subject> readManifest(const fs::path& manifest) {
+  const CsvTable table = readCsv(manifest);
+  const char* required[] = {"subject", "input", "joint", "side"};
+  for (size_t i = 0; i < 4; ++i)
+    if (table.header.size() <= i || table.header[i] != required[i])
+      throw InputError(manifest.string() + ":1: expected the header to start with subject,input,joint,side, found '" +
+                       csvLine(table.header) + "'");
+  const fs::path base = fs::absolute(manifest).parent_path();
+  std::vector<Subject> subjects;
+  std::set<std::string> seen;
+  for (size_t r = 0; r < table.rows.size(); ++r) {
+    const auto& row = table.rows[r];
+    const std::string where = manifest.string() + ":" + std::to_string(table.row_lines[r]) + ": ";
+    Subject s;
+    s.id = row[0];
+    s.line = table.row_lines[r];
+    if (s.id.empty()) throw InputError(where + "expected a subject id, found an empty field");
+    if (s.id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") != std::string::npos ||
+        s.id[0] == '.')
+      throw InputError(where + "subject id '" + s.id + "': expected letters, digits, '.', '_' or '-' only");
+    if (!seen.insert(s.id).second) throw InputError(where + "subject id '" + s.id + "' appears twice");
+    if (row[1].empty()) throw InputError(where + "expected an input path for subject '" + s.id + "'");
+    s.input = fs::path(row[1]).is_absolute() ? fs::path(row[1]) : (base / row[1]).lexically_normal();
+    s.joint = row[2].empty() ? "hip" : row[2];
+    s.side = row[3].empty() ? "right" : row[3];
+    if (s.joint != "hip" && s.joint != "shoulder")
+      throw InputError(where + "joint: expected hip or shoulder, found '" + s.joint + "'");
+    if (s.side != "left" && s.side != "right")
+      throw InputError(where + "side: expected left or right, found '" + s.side + "'");
+    for (size_t c = 4; c < table.header.size(); ++c) {
+      if (row[c].empty()) continue;
+      std::string option = "--" + table.header[c];
+      for (char& ch : option)
+        if (ch == '_') ch = '-';
+      s.options.push_back(option);
+      s.options.push_back(row[c]);
+    }
+    subjects.push_back(std::move(s));
+  }
+  if (subjects.empty()) throw InputError(manifest.string() + ": expected at least one subject row, found none");
+  return subjects;
+}
+
+std::vector<std::string> checkSubjectInput(const Subject& s) {
+  std::vector<std::string> problems;
+  std::error_code ec;
+  if (!fs::exists(s.input, ec)) {
+    problems.push_back("input '" + s.input.string() + "' does not exist");
+  } else if (fs::is_directory(s.input, ec)) {
+    bool any = false;
+    for (const auto& entry : fs::directory_iterator(s.input, ec))
+      if (entry.is_regular_file()) {
+        any = true;
+        break;
+      }
+    if (!any) problems.push_back("input folder '" + s.input.string() + "' holds no files (expected a DICOM series)");
+  } else {
+    const std::string name = s.input.filename().string();
+    auto ends = [&name](const std::string& suffix) {
+      return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+    };
+    if (!(ends(".nii") || ends(".nii.gz") || ends(".nrrd") || ends(".nhdr") || ends(".mha") || ends(".mhd")))
+      problems.push_back("input '" + s.input.string() +
+                         "': expected a DICOM folder or a .nii/.nii.gz/.nrrd/.mha image");
+    else if (fs::file_size(s.input, ec) == 0)
+      problems.push_back("input '" + s.input.string() + "' is empty");
+  }
+  return problems;
+}
+
+}  // namespace articula::pipeline

@@ -1,0 +1,40 @@
+#include "articula/pipeline/markups.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "articula/core/atomic_file.hpp"
+
+namespace articula::pipeline {
+
+namespace {
+nlohmann::json point(const std::string& id, const std::string& label, const Eigen::Vector3d& p) {
+  return {{"id", id}, {"label", label}, {"position", {p[0], p[1], p[2]}}, {"positionStatus", "defined"}};
+}
+nlohmann::json markup(const std::string& type, const std::string& name, nlohmann::json control_points) {
+  return {{"type", type},
+          {"name", name},
+          {"coordinateSystem", "LPS"},
+          {"coordinateUnits", "mm"},
+          {"locked", true},
+          {"controlPoints", std::move(control_points)}};
+}
+}  // namespace
+
+void writeSlicerMarkups(const std::filesystem::path& path, const std::string& name,
+                        const std::vector<Landmark>& points, const std::vector<LandmarkLine>& lines) {
+  nlohmann::json markups = nlohmann::json::array();
+  nlohmann::json cps = nlohmann::json::array();
+  for (size_t i = 0; i < points.size(); ++i) cps.push_back(point(std::to_string(i + 1), points[i].label, points[i].position));
+  markups.push_back(markup("Fiducial", name, cps));
+  for (const auto& line : lines)
+    markups.push_back(markup("Line", line.label,
+                             {point("1", line.label + "_start", line.start), point("2", line.label + "_end", line.end)}));
+  const nlohmann::json doc = {
+      {"@schema",
+       "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/Schema/"
+       "markups-schema-v1.0.3.json#"},
+      {"markups", markups}};
+  writeFileAtomically(path, doc.dump(2) + "\n");
+}
+
+}  // namespace articula::pipeline

@@ -1,0 +1,171 @@
+#include "articula/pipeline/study.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "articula/core/atomic_file.hpp"
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+#include "articula/pipeline/csv.hpp"
+#include "articula/pipeline/statistics.hpp"
+
+namespace articula::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "";
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// Error-statistic columns of study.csv, in order, read from models[].errors.
+const std::vector<std::string> kErrorColumns = {"n_points", "rms_mm", "mean_mm", "sd_mm", "min_mm",
+                                                "max_mm",   "mean_abs_mm", "sse_mm2"};
+
+struct ModelRow {
+  std::string subject, model;
+  nlohmann::json entry;  // the model's entry of results.json
+  bool best = false;
+};
+
+}  // namespace
+
+nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Subject>& subjects,
+                                const BatchSummary& batch, const nlohmann::json& provenance) {
+  std::vector<ModelRow> rows;
+  std::vector<std::string> parameter_columns;  // union, in order of first appearance
+  std::vector<std::string> model_order;
+  for (size_t i = 0; i < subjects.size(); ++i) {
+    if (batch.outcomes[i].status != "ok") continue;
+    const fs::path path = subjectDir(study_dir, subjects[i].id) / "results.json";
+    std::ifstream in(path);
+    nlohmann::json results;
+    try {
+      results = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+      throw ProcessingError("cannot read '" + path.string() + "': " + e.what());
+    }
+    const std::string best = results.value("best_model", "");
+    for (const auto& m : results.at("models")) {
+      ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best};
+      for (const auto& [key, value] : m.at("parameters").items())
+        if (std::find(parameter_columns.begin(), parameter_columns.end(), key) == parameter_columns.end())
+          parameter_columns.push_back(key);
+      if (std::find(model_order.begin(), model_order.end(), row.model) == model_order.end())
+        model_order.push_back(row.model);
+      rows.push_back(std::move(row));
+    }
+  }
+
+  // study.csv
+  std::vector<std::string> header = {"subject", "model", "n_parameters"};
+  header.insert(header.end(), kErrorColumns.begin(), kErrorColumns.end());
+  header.insert(header.end(), {"aic", "bic", "best_by_rms"});
+  header.insert(header.end(), parameter_columns.begin(), parameter_columns.end());
+  std::string study_csv = csvLine(header) + "\n";
+  for (const auto& r : rows) {
+    std::vector<std::string> f = {r.subject, r.model, number(r.entry.value("n_parameters", 0))};
+    for (const auto& c : kErrorColumns) f.push_back(number(r.entry.at("errors").value(c, NAN)));
+    f.push_back(number(r.entry.value("aic", NAN)));
+    f.push_back(number(r.entry.value("bic", NAN)));
+    f.push_back(r.best ? "1" : "0");
+    for (const auto& c : parameter_columns)
+      f.push_back(r.entry.at("parameters").contains(c) ? number(r.entry.at("parameters").at(c).get<double>()) : "");
+    study_csv += csvLine(f) + "\n";
+  }
+
+  // Per subject, the model with the least AIC and BIC; per model, RMS by subject.
+  std::map<std::string, std::map<std::string, const ModelRow*>> by_subject;
+  for (const auto& r : rows) by_subject[r.subject][r.model] = &r;
+  std::map<std::string, int> best_rms, best_aic, best_bic;
+  for (const auto& [subject, models] : by_subject) {
+    const ModelRow *a = nullptr, *b = nullptr;
+    for (const auto& [name, row] : models) {
+      if (!a || row->entry.value("aic", INFINITY) < a->entry.value("aic", INFINITY)) a = row;
+      if (!b || row->entry.value("bic", INFINITY) < b->entry.value("bic", INFINITY)) b = row;
+      if (row->best) ++best_rms[name];
+    }
+    if (a) ++best_aic[a->model];
+    if (b) ++best_bic[b->model];
+  }
+
+  nlohmann::json summary_json = nlohmann::json::array();
+  std::string summary_csv = csvLine({"model", "n_subjects", "rms_mean_mm", "rms_sd_mm", "times_best_by_rms",
+                                     "times_best_by_aic", "times_best_by_bic", "mean_delta_aic_vs_sphere",
+                                     "mean_delta_bic_vs_sphere", "wilcoxon_n_vs_sphere", "wilcoxon_p_vs_sphere"}) +
+                            "\n";
+  for (const auto& model : model_order) {
+    std::vector<double> rms, rms_sphere, d_aic, d_bic;
+    for (const auto& [subject, models] : by_subject) {
+      auto it = models.find(model);
+      if (it == models.end()) continue;
+      rms.push_back(it->second->entry.at("errors").value("rms_mm", NAN));
+      auto sphere = models.find("sphere");
+      if (sphere != models.end()) {
+        rms_sphere.push_back(sphere->second->entry.at("errors").value("rms_mm", NAN));
+        d_aic.push_back(it->second->entry.value("aic", NAN) - sphere->second->entry.value("aic", NAN));
+        d_bic.push_back(it->second->entry.value("bic", NAN) - sphere->second->entry.value("bic", NAN));
+      }
+    }
+    const Summary s = summarise(rms);
+    WilcoxonResult w;
+    const bool paired = model != "sphere" && rms_sphere.size() == rms.size() && !rms.empty();
+    if (paired) w = wilcoxonSignedRank(rms, rms_sphere);
+    const std::vector<std::string> f = {model,
+                                        std::to_string(s.n),
+                                        number(s.mean),
+                                        number(s.sd),
+                                        std::to_string(best_rms[model]),
+                                        std::to_string(best_aic[model]),
+                                        std::to_string(best_bic[model]),
+                                        d_aic.empty() ? "" : number(summarise(d_aic).mean),
+                                        d_bic.empty() ? "" : number(summarise(d_bic).mean),
+                                        paired ? std::to_string(w.n_used) : "",
+                                        paired ? number(w.p_value) : ""};
+    summary_csv += csvLine(f) + "\n";
+    nlohmann::json entry = {{"model", model},
+                            {"n_subjects", s.n},
+                            {"rms_mean_mm", s.mean},
+                            {"rms_sd_mm", s.sd},
+                            {"times_best_by_rms", best_rms[model]},
+                            {"times_best_by_aic", best_aic[model]},
+                            {"times_best_by_bic", best_bic[model]}};
+    if (paired)
+      entry["wilcoxon_vs_sphere"] = {{"n", w.n_used}, {"w_plus", w.w_plus}, {"p_value", w.p_value}, {"exact", w.exact}};
+    summary_json.push_back(entry);
+  }
+
+  std::string status_csv = csvLine({"subject", "status", "exit_code", "seconds", "message"}) + "\n";
+  nlohmann::json status_json = nlohmann::json::array();
+  for (size_t i = 0; i < subjects.size(); ++i) {
+    const auto& o = batch.outcomes[i];
+    status_csv += csvLine({o.id, o.status, std::to_string(o.exit_code), number(o.seconds), o.message}) + "\n";
+    status_json.push_back({{"subject", o.id},
+                           {"status", o.status},
+                           {"exit_code", o.exit_code},
+                           {"message", o.message},
+                           {"resumed", o.resumed}});
+  }
+
+  nlohmann::json study = {{"subjects", status_json},
+                          {"models", summary_json},
+                          {"succeeded", batch.succeeded},
+                          {"failed", batch.failed},
+                          {"coordinate_system", "LPS"},
+                          {"units", "mm"},
+                          {"provenance", provenance}};
+  writeFileAtomically(study_dir / "study.csv", study_csv);
+  writeFileAtomically(study_dir / "study_summary.csv", summary_csv);
+  writeFileAtomically(study_dir / "study_status.csv", status_csv);
+  writeFileAtomically(study_dir / "study.json", study.dump(2) + "\n");
+  return study;
+}
+
+}  // namespace articula::pipeline
