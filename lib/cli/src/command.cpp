@@ -146,6 +146,21 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
   return static_cast<int>(ExitCode::UsageError);
 }
 
+int runCommandInProcess(const std::string& name, const std::vector<std::string>& args) {
+  std::vector<std::string> full = {"articula " + name};
+  full.insert(full.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : full) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string outer = commandLine();
+  std::vector<const char*> shown = {"articula", name.c_str()};
+  for (const auto& a : args) shown.push_back(a.c_str());
+  setCommandLine(static_cast<int>(shown.size()), shown.data());
+  const int rc = runSingle(static_cast<int>(full.size()), argv.data(), full[0], createCommand(name));
+  setCommandLineString(outer);
+  return rc;
+}
+
 void printJson(const nlohmann::json& summary) { std::cout << summary.dump(2) << std::endl; }
 
 }  // namespace articula::cli

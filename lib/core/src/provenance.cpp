@@ -65,6 +65,7 @@ void setCommandLine(int argc, const char* const* argv) {
 }
 
 std::string commandLine() { return g_command_line; }
+void setCommandLineString(const std::string& command) { g_command_line = command; }
 
 nlohmann::json provenanceJson(const Provenance& p) {
   nlohmann::json inputs = nlohmann::json::array();

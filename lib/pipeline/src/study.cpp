@@ -26,8 +26,9 @@ std::string number(double v) {
 }
 
 // Error-statistic columns of study.csv, in order, read from models[].errors.
-const std::vector<std::string> kErrorColumns = {"n_points", "rms_mm", "mean_mm", "sd_mm", "min_mm",
-                                                "max_mm",   "mean_abs_mm", "sse_mm2"};
+// (the columns of the errors stage's summary, thesis tables 3.3-3.4).
+const std::vector<std::string> kErrorColumns = {"n_points",    "rms_mm",     "min_mm",      "max_mm",         "mean_abs_mm",
+                                                "std_abs_mm", "gauss_mu_mm", "gauss_sigma_mm", "sse_mm2"};
 
 struct ModelRow {
   std::string subject, model;

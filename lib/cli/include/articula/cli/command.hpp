@@ -62,6 +62,12 @@ int runCommandMain(int argc, char** argv, std::unique_ptr<Command> command);
 /// Main of the driver: dispatches `articula <command> ...`.
 int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> commands);
 
+/// Runs the registered command `name` in this process with `args` (without
+/// the program name), exactly as `articula <name> args...` would, returning
+/// its exit code; errors are reported on stderr as usual. Provenance written
+/// by the command records `articula <name> args...` as its command line.
+int runCommandInProcess(const std::string& name, const std::vector<std::string>& args);
+
 /// Prints a JSON summary on stdout (for --json).
 void printJson(const nlohmann::json& summary);
 

@@ -17,6 +17,7 @@ std::string sha256String(const std::string& bytes);
 /// The command line of this process, as one shell-like string.
 std::string commandLine();
 void setCommandLine(int argc, const char* const* argv);
+void setCommandLineString(const std::string& command);
 
 struct Provenance {
   nlohmann::json parameters = nlohmann::json::object();
