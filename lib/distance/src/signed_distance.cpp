@@ -27,8 +27,9 @@ bool isQuadric(ShapeModel m) { return m == ShapeModel::Sphere || m == ShapeModel
 }  // namespace
 
 SignedDistance::SignedDistance(const geometry::ShapeParameters& shape)
-    : shape_(shape), surface_(geometry::makeSurface(shape)), pose_(surface_->pose()), rotation_(pose_.rotation) {
-  if (isQuadric(shape.model)) return;
+    : shape_(shape), surface_(geometry::makeSurface(shape)), pose_(surface_->pose()), rotation_(pose_.rotation) {}
+
+void SignedDistance::buildSeeds() const {
   // Seeds: an exact parametric sample of the surface, and the longest edge
   // between neighbours, which bounds how far any surface point is from a seed.
   const geometry::SurfaceMesh mesh = surface_->sample(32, 16);
@@ -101,7 +102,10 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
     return (qq - y + m * ee.gradient).squaredNorm() + ee.value * ee.value / ee.gradient.squaredNorm();
   };
   double current = merit(q, mu, e);
-  for (int iteration = 0; iteration < 60; ++iteration) {
+  const double tolerance = 1e-12 * scale;
+  for (int iteration = 0;; ++iteration) {
+    if (current <= tolerance * tolerance) break;
+    if (iteration == 60) return false;
     Eigen::Matrix4d J;
     J.topLeftCorner<3, 3>() = Matrix3d::Identity() + mu * e.hessian;
     J.topRightCorner<3, 1>() = e.gradient;
@@ -119,7 +123,7 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
       const double mu_new = mu + alpha * step[3];
       const LocalEvaluation e_new = evaluateLocal(*surface_, inv_r, q_new);
       const double m_new = merit(q_new, mu_new, e_new);
-      if (m_new < current || m_new == 0.0) {
+      if (m_new < current) {
         q = q_new;
         mu = mu_new;
         e = e_new;
@@ -128,13 +132,11 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
         break;
       }
     }
-    const double moved = alpha * step.head<3>().norm();
-    if (!accepted || moved <= 1e-14 * scale) {
-      // Converged when the residual is at rounding level.
-      if (current > 1e-22 * scale * scale) return false;
+    // Stalled: accept only at (near) rounding level.
+    if (!accepted) {
+      if (current > 1e4 * tolerance * tolerance) return false;
       break;
     }
-    if (iteration == 59) return false;
   }
   const double dist = (y - q).norm();
   const double f_y = evaluateLocal(*surface_, inv_r, y).value;
@@ -190,6 +192,7 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     result.point = rotation_ * q + pose_.translation;
     return result;
   }
+  if (seeds_.rows() == 0) buildSeeds();
   // Nearest seed first.
   Eigen::Index nearest = 0;
   const Eigen::VectorXd seed_d2 = (seeds_.rowwise() - y.transpose()).rowwise().squaredNorm();

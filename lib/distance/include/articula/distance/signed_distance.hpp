@@ -56,8 +56,10 @@ class SignedDistance {
   std::unique_ptr<geometry::PosedSurface> surface_;
   geometry::Pose pose_;
   Eigen::Matrix3d rotation_;
-  Eigen::MatrixX3d seeds_;  // surface sample (global mm)
-  double seed_spacing_ = 0.0;
+  void buildSeeds() const;
+  // Built on first use, so that warm-started evaluation (fitting) skips it.
+  mutable Eigen::MatrixX3d seeds_;  // surface sample in the rotated frame (mm)
+  mutable double seed_spacing_ = 0.0;
 };
 
 /// Signed distances of `points` (#P x 3) to `shape`: convenience over SignedDistance.
