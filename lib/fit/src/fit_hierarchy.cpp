@@ -12,6 +12,7 @@
 #include "articula/core/log.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
+#include "articula/fit/parameter_gradient.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
 
@@ -148,39 +149,6 @@ VectorXd initialSteps(ShapeModel model, const ShapeParameters& start) {
   return step;
 }
 
-// dF/dlambda (#P x M) of the shape `lambda` at the fixed points `at` (#P x 3),
-// by central differences of F (one-sided at the edge of the valid set, e.g.
-// exponents at 2). With the closest points as `at`, dividing by |grad F|
-// gives the derivative of the signed distances (the envelope theorem).
-Eigen::MatrixXd parameterDerivatives(ShapeModel model, const VectorXd& lambda, const Eigen::MatrixX3d& at,
-                                     const VectorXd& h) {
-  const Eigen::Index n = at.rows(), m = lambda.size();
-  auto values = [&](const VectorXd& l, VectorXd& f) {
-    try {
-      const auto surface = geometry::makeSurface(geometry::fromVector(model, l));
-      f.resize(n);
-      for (Eigen::Index i = 0; i < n; ++i) f[i] = surface->value(at.row(i).transpose());
-      return true;
-    } catch (const InvalidParameter&) {
-      return false;
-    }
-  };
-  VectorXd f0, fp, fm;
-  values(lambda, f0);
-  Eigen::MatrixXd J(n, m);
-  for (Eigen::Index k = 0; k < m; ++k) {
-    VectorXd lp = lambda, lm = lambda;
-    lp[k] += h[k];
-    lm[k] -= h[k];
-    const bool up = values(lp, fp), down = values(lm, fm);
-    if (up && down) J.col(k) = (fp - fm) / (2.0 * h[k]);
-    else if (up) J.col(k) = (fp - f0) / h[k];
-    else if (down) J.col(k) = (f0 - fm) / h[k];
-    else J.col(k).setZero();
-  }
-  return J;
-}
-
 // The objective seen by NLopt, in scaled variables x = (lambda - lambda0) / s
 // so that every parameter moves on a unit scale; it remembers the best point
 // it was shown, so a run never returns anything worse than its start.
@@ -209,7 +177,7 @@ class ObjectiveFunction {
         field.evaluate(points_, d_, feet_, best_feet_.rows() == points_.rows());
       }
       f = d_.squaredNorm();
-      if (!grad.empty()) gradient(p, lambda, grad);
+      if (!grad.empty()) gradient(p, grad);
     } catch (const InvalidParameter&) {
       // Outside the valid set (e.g. an ovoid denominator reaching 0 on [-1, 1]).
       if (!grad.empty()) std::fill(grad.begin(), grad.end(), 0.0);
@@ -233,13 +201,14 @@ class ObjectiveFunction {
   VectorXd best_lambda;
 
  private:
-  void gradient(const ShapeParameters& p, const VectorXd& lambda, std::vector<double>& grad) const {
-    const VectorXd h = 1e-6 * scale_;
-    const Eigen::MatrixX3d& at = kind_ == Objective::Algebraic ? points_ : feet_;
-    Eigen::MatrixXd J = parameterDerivatives(model_, lambda, at, h);
-    if (kind_ == Objective::Geometric) {
-      const auto surface = geometry::makeSurface(p);
-      for (Eigen::Index i = 0; i < at.rows(); ++i) J.row(i) /= surface->gradient(at.row(i).transpose()).norm();
+  void gradient(const ShapeParameters& p, std::vector<double>& grad) const {
+    Eigen::MatrixXd J;
+    VectorXd norms;
+    if (kind_ == Objective::Algebraic) {
+      parameterGradient(p, points_, J, norms);
+    } else {
+      parameterGradient(p, feet_, J, norms);
+      J.array().colwise() /= norms.array();
     }
     const VectorXd g = 2.0 * (J.transpose() * d_).cwiseProduct(scale_);
     std::copy(g.data(), g.data() + g.size(), grad.begin());
