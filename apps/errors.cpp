@@ -97,7 +97,11 @@ class ErrorsCommand : public cli::Command {
       }
     }
     const std::vector<geometry::ShapeParameters> shapes = fit::shapesFromFitsJson(doc, fits_.string());
-    std::filesystem::create_directories(output_);
+    if (std::filesystem::exists(output_) && !std::filesystem::is_directory(output_))
+      throw UsageError("--output: expected a folder, found the file '" + output_.string() + "'");
+    std::error_code ec;
+    std::filesystem::create_directories(output_, ec);
+    if (ec) throw InputError("--output: cannot create the folder '" + output_.string() + "': " + ec.message());
     const std::vector<std::string> outputs = {"summary.csv", "summary.json", "errors.csv", "histogram.svg"};
     for (const auto& f : outputs)
       if (std::filesystem::exists(output_ / f) && !common.force)

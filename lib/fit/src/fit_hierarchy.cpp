@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include <Eigen/Geometry>
 #include <nlopt.hpp>
 
 #include "articula/core/error.hpp"
@@ -54,6 +55,7 @@ void Options::validate() const {
   localAlgorithm(local_algorithm);
   require(max_evaluations > 0, "max_evaluations: expected > 0");
   require(global_evaluations > 0, "global_evaluations: expected > 0");
+  require(screening_evaluations >= 0, "screening_evaluations: expected >= 0");
   require(relative_tolerance >= 0.0 && parameter_tolerance >= 0.0, "tolerances: expected >= 0");
   require(radius_interval > 0.0 && radius_interval < 1.0, "radius_interval: expected in (0, 1)");
   require(center_interval > 0.0, "center_interval: expected > 0");
@@ -308,12 +310,35 @@ double rmsOf(const ShapeParameters& p, const Eigen::MatrixX3d& points, double& s
 }
 
 // Fits `model` from each start (label, parameters) and keeps the best.
-ModelFit fitModel(ShapeModel model, const std::vector<std::pair<std::string, ShapeParameters>>& starts,
-                  const Bounds& model_bounds, const Eigen::MatrixX3d& points, const Options& o) {
+// With `screen` > 0 and several starts, every start first gets `screen`
+// evaluations and only the best one is run to convergence.
+ModelFit fitModel(ShapeModel model, std::vector<std::pair<std::string, ShapeParameters>> starts,
+                  const Bounds& model_bounds, const Eigen::MatrixX3d& points, const Options& o, int screen = 0) {
   const auto t0 = Clock::now();
   const nlopt::algorithm local = localAlgorithm(o.local_algorithm);
   ModelFit best;
   double best_value = std::numeric_limits<double>::infinity();
+  int screening_evaluations = 0;
+  if (screen > 0 && starts.size() > 1) {
+    Options short_run = o;
+    short_run.max_evaluations = screen;
+    short_run.strategy = Strategy::Local;
+    std::pair<std::string, ShapeParameters> winner;
+    for (const auto& [label, start_shape] : starts) {
+      const ShapeParameters start = geometry::promote(start_shape, model);
+      const VectorXd x0 = geometry::toVector(start);
+      const RunResult r = runNlopt(local, model, x0, boundsForStart(model_bounds, model, x0),
+                                   initialSteps(model, start), screen, points, short_run);
+      screening_evaluations += r.evaluations;
+      if (r.value < best_value) {
+        best_value = r.value;
+        winner = {label, geometry::fromVector(model, r.x)};
+      }
+    }
+    starts = {winner};
+    best_value = std::numeric_limits<double>::infinity();
+  }
+  best.evaluations = screening_evaluations;
   for (const auto& [label, start_shape] : starts) {
     const ShapeParameters start = geometry::promote(start_shape, model);
     const VectorXd x0 = geometry::toVector(start);
@@ -350,6 +375,27 @@ ModelFit fitModel(ShapeModel model, const std::vector<std::pair<std::string, Sha
   best.algebraic_objective = algebraicObjective(best.parameters, points);
   best.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return best;
+}
+
+// The six labellings of an ellipsoid's axes with a right-handed frame (local
+// z along each axis, either way): the same surface, but distinct starts for
+// the ovoid, whose asymmetry runs along local z (c1 >= 0: wider towards +z).
+std::vector<std::pair<std::string, ShapeParameters>> axisLabellings(const ShapeParameters& e) {
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(e.angles);
+  std::vector<std::pair<std::string, ShapeParameters>> out;
+  for (int k = 2; k < 5; ++k)
+    for (double sign : {1.0, -1.0}) {
+      const int iz = k % 3, ix = (k + 1) % 3, iy = (k + 2) % 3;
+      Eigen::Matrix3d L;
+      L.col(2) = sign * R.col(iz);
+      L.col(0) = R.col(ix);
+      L.col(1) = L.col(2).cross(L.col(0));
+      ShapeParameters p = e;
+      p.radii = Eigen::Vector3d(e.radii[ix], e.radii[iy], e.radii[iz]);
+      p.angles = geometry::anglesFromRotation(L);
+      out.emplace_back(std::string("ellipsoid (z = ") + (sign > 0 ? "+" : "-") + "xyz"[iz] + ")", p);
+    }
+  return out;
 }
 
 // The nesting guarantee: a child never reports a worse RMS than its parent.
@@ -427,7 +473,8 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
     enforceNesting(superellipsoid, ellipsoid, points);
   }
   if (need_o) {
-    ovoid = fitModel(ShapeModel::Ovoid, {{"ellipsoid", ellipsoid.parameters}}, bounds(ShapeModel::Ovoid), points, o);
+    ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(ellipsoid.parameters), bounds(ShapeModel::Ovoid), points, o,
+                     o.screening_evaluations);
     enforceNesting(ovoid, ellipsoid, points);
   }
   if (wanted(ShapeModel::Superovoid)) {
