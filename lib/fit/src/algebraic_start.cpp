@@ -1,5 +1,8 @@
 #include "articula/fit/algebraic_start.hpp"
 
+#include <complex>
+#include <limits>
+
 #include <Eigen/Dense>
 
 #include "articula/core/error.hpp"
@@ -67,13 +70,22 @@ ShapeParameters algebraicEllipsoid(const Eigen::MatrixX3d& points) {
   C1.bottomRightCorner<3, 3>().diagonal().setConstant(-k);
   const MatrixXd S22_inv_S21 = S22.ldlt().solve(S12.transpose());
   const MatrixXd M = C1.inverse() * (S11 - S12 * S22_inv_S21);
+  // The solution is the eigenvector with 4J - I^2 = v^T C1 v > 0 (its
+  // eigenvalue is the algebraic error, >= 0, and 0 to rounding on exact data).
   Eigen::EigenSolver<MatrixXd> eig(M);
   int best = -1;
-  for (int i = 0; i < 6; ++i)
-    if (std::abs(eig.eigenvalues()[i].imag()) < 1e-12 * std::abs(eig.eigenvalues()[i]) + 1e-300 &&
-        eig.eigenvalues()[i].real() > 0.0 && (best < 0 || eig.eigenvalues()[i].real() > eig.eigenvalues()[best].real()))
+  double best_error = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 6; ++i) {
+    const std::complex<double> lambda = eig.eigenvalues()[i];
+    if (std::abs(lambda.imag()) > 1e-9 * (1.0 + std::abs(lambda))) continue;
+    const Eigen::VectorXd v = eig.eigenvectors().col(i).real();
+    if (!(v.dot(C1 * v) > 0.0)) continue;
+    if (std::abs(lambda.real()) < best_error) {
+      best_error = std::abs(lambda.real());
       best = i;
-  if (best < 0) throw ProcessingError("ellipsoid-specific fit: no positive eigenvalue (degenerate points)");
+    }
+  }
+  if (best < 0) throw ProcessingError("ellipsoid-specific fit: no ellipsoid solution (degenerate points)");
   const Eigen::VectorXd v1 = eig.eigenvectors().col(best).real();
   const Eigen::VectorXd v2 = -S22_inv_S21 * v1;
   Matrix3d A;

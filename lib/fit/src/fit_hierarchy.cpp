@@ -55,7 +55,7 @@ void Options::validate() const {
   localAlgorithm(local_algorithm);
   require(max_evaluations > 0, "max_evaluations: expected > 0");
   require(global_evaluations > 0, "global_evaluations: expected > 0");
-  require(screening_evaluations >= 0, "screening_evaluations: expected >= 0");
+  require(screening_evaluations >= 0 && restarts >= 0, "screening_evaluations, restarts: expected >= 0");
   require(relative_tolerance >= 0.0 && parameter_tolerance >= 0.0, "tolerances: expected >= 0");
   require(radius_interval > 0.0 && radius_interval < 1.0, "radius_interval: expected in (0, 1)");
   require(center_interval > 0.0, "center_interval: expected > 0");
@@ -357,6 +357,15 @@ ModelFit fitModel(ShapeModel model, std::vector<std::pair<std::string, ShapePara
       run = runNlopt(local, model, x0, b, steps, o.max_evaluations, points, o);
     }
     evaluations += run.evaluations;
+    // SLSQP's objective test can stop on a short step while still descending:
+    // restart (a fresh quasi-Newton model) while that still gains.
+    for (int restart = 0; restart < o.restarts; ++restart) {
+      const RunResult again = runNlopt(local, model, run.x, b, steps, o.max_evaluations, points, o);
+      evaluations += again.evaluations;
+      const bool gained = again.value < run.value * (1.0 - 1e-6) && again.value > 1e-20 * static_cast<double>(points.rows());
+      if (again.value < run.value) run = again;
+      if (!gained) break;
+    }
     best.evaluations += evaluations;
     if (run.value < best_value) {
       best_value = run.value;
@@ -396,6 +405,22 @@ std::vector<std::pair<std::string, ShapeParameters>> axisLabellings(const ShapeP
       out.emplace_back(std::string("ellipsoid (z = ") + (sign > 0 ? "+" : "-") + "xyz"[iz] + ")", p);
     }
   return out;
+}
+
+// A third superovoid start that joins what both parents learnt: the ovoid
+// with the exponents of the superellipsoid, each taken from the
+// superellipsoid axis most parallel to the ovoid's.
+ShapeParameters combineParents(const ShapeParameters& superellipsoid, const ShapeParameters& ovoid) {
+  ShapeParameters p = geometry::promote(ovoid, ShapeModel::Superovoid);
+  const Eigen::Matrix3d Ro = geometry::rotationFromAngles(ovoid.angles);
+  const Eigen::Matrix3d Rs = geometry::rotationFromAngles(superellipsoid.angles);
+  for (int i = 0; i < 3; ++i) {
+    int best = 0;
+    for (int j = 1; j < 3; ++j)
+      if (std::fabs(Ro.col(i).dot(Rs.col(j))) > std::fabs(Ro.col(i).dot(Rs.col(best)))) best = j;
+    p.exponents[i] = superellipsoid.exponents[best];
+  }
+  return p;
 }
 
 // The nesting guarantee: a child never reports a worse RMS than its parent.
@@ -479,7 +504,10 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   }
   if (wanted(ShapeModel::Superovoid)) {
     superovoid = fitModel(ShapeModel::Superovoid,
-                          {{"superellipsoid", superellipsoid.parameters}, {"ovoid", ovoid.parameters}},
+                          {{"superellipsoid", superellipsoid.parameters},
+                           {"ovoid", ovoid.parameters},
+                           {"ovoid with the superellipsoid's exponents",
+                            combineParents(superellipsoid.parameters, ovoid.parameters)}},
                           bounds(ShapeModel::Superovoid), points, o);
     enforceNesting(superovoid, superellipsoid.rms_mm <= ovoid.rms_mm ? superellipsoid : ovoid, points);
   }

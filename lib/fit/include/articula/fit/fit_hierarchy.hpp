@@ -42,6 +42,7 @@ struct Options {
   unsigned seed = 42;                  // NLopt's random seed (CRS2)
   int max_evaluations = 4000;          // per local run
   int global_evaluations = 3000;       // per global run (GlobalLocal)
+  int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
   int screening_evaluations = 40;      // ovoid: per axis labelling of the ellipsoid, before the best is finished
   double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
   double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
