@@ -1,0 +1,171 @@
+// `articula errors` / articula-errors: signed Euclidean distances from the
+// points to every fitted model (fits.json), with thesis tables 3.3-3.4
+// (summary.csv/.json), per-point errors.csv, the histograms of fig. 3.5
+// (histogram.svg), points coloured as fig. 3.4 and each fitted surface (PLY).
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+#include "articula/cli/command.hpp"
+#include "articula/core/atomic_file.hpp"
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+#include "articula/core/provenance.hpp"
+#include "articula/distance/signed_distance.hpp"
+#include "articula/fit/fits_json.hpp"
+#include "articula/geometry/surface.hpp"
+#include "articula/points/point_io.hpp"
+#include "articula/report/error_statistics.hpp"
+#include "articula/report/histogram_svg.hpp"
+#include "articula/report/ply_writers.hpp"
+
+namespace articula::apps {
+namespace {
+
+// The fitted surface over the points' angular extent: the triangles of an
+// exact sample whose vertices all lie within the largest angle, seen from the
+// shape's centre, between the points and their mean direction (plus 5 degrees).
+geometry::SurfaceMesh surfacePatch(const geometry::PosedSurface& s, const Eigen::MatrixX3d& points, int resolution) {
+  const geometry::SurfaceMesh full = s.sample(resolution, resolution / 2);
+  const Eigen::Vector3d c = s.pose().translation;
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < points.rows(); ++i) axis += (points.row(i).transpose() - c).normalized();
+  if (axis.norm() < 1e-9 * static_cast<double>(points.rows())) return full;  // points all round: whole surface
+  axis.normalize();
+  double max_angle = 0.0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+    max_angle = std::max(max_angle, std::acos(std::clamp(axis.dot((points.row(i).transpose() - c).normalized()), -1.0, 1.0)));
+  const double limit = std::cos(std::min(M_PI, max_angle + 5.0 * M_PI / 180.0));
+  std::vector<int> keep_vertex(static_cast<size_t>(full.vertices.rows()), -1);
+  std::vector<Eigen::Vector3i> tris;
+  for (Eigen::Index f = 0; f < full.triangles.rows(); ++f) {
+    bool inside = true;
+    for (int k = 0; k < 3; ++k)
+      inside = inside && axis.dot((full.vertices.row(full.triangles(f, k)).transpose() - c).normalized()) >= limit;
+    if (inside) tris.emplace_back(full.triangles.row(f).transpose());
+  }
+  geometry::SurfaceMesh patch;
+  std::vector<Eigen::Vector3d> verts;
+  patch.triangles.resize(static_cast<Eigen::Index>(tris.size()), 3);
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      int& id = keep_vertex[static_cast<size_t>(tris[t][k])];
+      if (id < 0) {
+        id = static_cast<int>(verts.size());
+        verts.emplace_back(full.vertices.row(tris[t][k]).transpose());
+      }
+      patch.triangles(static_cast<Eigen::Index>(t), k) = id;
+    }
+  patch.vertices.resize(static_cast<Eigen::Index>(verts.size()), 3);
+  for (size_t v = 0; v < verts.size(); ++v) patch.vertices.row(static_cast<Eigen::Index>(v)) = verts[v].transpose();
+  return patch;
+}
+
+class ErrorsCommand : public cli::Command {
+ public:
+  std::string name() const override { return "errors"; }
+  std::string description() const override {
+    return "Signed Euclidean distances to the fitted models: tables 3.3-3.4, errors.csv, histogram.svg, coloured PLY";
+  }
+  std::string example() const override { return "articula-errors -i head.ply --fits fits.json -o errors/"; }
+  void declare(CLI::App& app) override {
+    app.add_option("-i,--input", input_, "The points that were fitted (LPS mm)")->required();
+    app.add_option("--fits", fits_, "fits.json written by articula-fit")->required();
+    app.add_option("-o,--output", output_, "Output folder")->required();
+    app.add_option("--band", band_mm_, "Half-width of the green band of the coloured points (mm)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--resolution", resolution_, "Surface mesh steps around the local z axis")
+        ->check(CLI::Range(8, 2048))
+        ->capture_default_str();
+  }
+
+  int run(const cli::CommonOptions& common) override {
+    const points::PointCloud cloud = points::readPoints(input_);
+    points::checkFittable(cloud, 1, input_.string());
+    nlohmann::json doc;
+    {
+      std::ifstream in(fits_);
+      if (!in) throw InputError("--fits: cannot open '" + fits_.string() + "'");
+      try {
+        in >> doc;
+      } catch (const std::exception& e) {
+        throw InputError("--fits: '" + fits_.string() + "' is not valid JSON: " + e.what());
+      }
+    }
+    const std::vector<geometry::ShapeParameters> shapes = fit::shapesFromFitsJson(doc, fits_.string());
+    if (std::filesystem::exists(output_) && !std::filesystem::is_directory(output_))
+      throw UsageError("--output: expected a folder, found the file '" + output_.string() + "'");
+    std::error_code ec;
+    std::filesystem::create_directories(output_, ec);
+    if (ec) throw InputError("--output: cannot create the folder '" + output_.string() + "': " + ec.message());
+    const std::vector<std::string> outputs = {"summary.csv", "summary.json", "errors.csv", "histogram.svg"};
+    for (const auto& f : outputs)
+      if (std::filesystem::exists(output_ / f) && !common.force)
+        throw UsageError("output '" + (output_ / f).string() + "' exists (use --force to overwrite)");
+
+    const Eigen::MatrixX3d& P = cloud.positions;
+    std::vector<report::ErrorStatistics> rows;
+    std::vector<report::Series> series;
+    Eigen::MatrixXd all(P.rows(), static_cast<Eigen::Index>(shapes.size()));
+    for (size_t m = 0; m < shapes.size(); ++m) {
+      const std::string name = geometry::modelName(shapes[m].model);
+      const Eigen::VectorXd d = distance::signedDistances(shapes[m], P);
+      all.col(static_cast<Eigen::Index>(m)) = d;
+      rows.push_back(report::errorStatistics(name, d));
+      series.push_back({name, d, rows.back().gauss_mu_mm, rows.back().gauss_sigma_mm});
+      log::info(name + ": rms " + std::to_string(rows.back().rms_mm) + " mm");
+      const std::string comment = "articula errors: " + name + " signed Euclidean distances (mm), points " +
+                                  input_.filename().string();
+      writeFileAtomically(output_ / ("points_" + name + ".ply"),
+                          report::colouredPointsPly(P, d, band_mm_, comment), common.force);
+      const auto surface = geometry::makeSurface(shapes[m]);
+      const geometry::SurfaceMesh patch = surfacePatch(*surface, P, resolution_);
+      writeFileAtomically(output_ / ("surface_" + name + ".ply"),
+                          report::meshPly(patch.vertices, patch.triangles, "articula fitted " + name), common.force);
+    }
+
+    nlohmann::json params = {{"fits", fits_.string()}, {"band_mm", band_mm_}, {"resolution", resolution_}};
+    const nlohmann::json provenance = provenanceJson({params, {input_, fits_}, -1});
+    writeFileAtomically(output_ / "summary.csv", report::summaryCsv(rows), common.force);
+    writeFileAtomically(output_ / "summary.json",
+                        nlohmann::json({{"coordinate_system", "LPS"},
+                                        {"units", "mm"},
+                                        {"models", report::summaryJson(rows)},
+                                        {"provenance", provenance}})
+                                .dump(2) +
+                            "\n",
+                        common.force);
+    {
+      AtomicFile file(output_ / "errors.csv", common.force);
+      std::ostream& out = file.stream();
+      out << "x_mm,y_mm,z_mm";
+      for (const auto& s : shapes) out << ",d_" << geometry::modelName(s.model) << "_mm";
+      out << "\n" << std::setprecision(12);
+      for (Eigen::Index i = 0; i < P.rows(); ++i) {
+        out << P(i, 0) << ',' << P(i, 1) << ',' << P(i, 2);
+        for (Eigen::Index m = 0; m < all.cols(); ++m) out << ',' << all(i, m);
+        out << '\n';
+      }
+      file.commit();
+    }
+    writeFileAtomically(output_ / "histogram.svg",
+                        report::histogramSvg(series, "Signed Euclidean distances: " + input_.filename().string()),
+                        common.force);
+    if (common.json) cli::printJson({{"output", output_.string()}, {"models", report::summaryJson(rows)}});
+    return 0;
+  }
+
+ private:
+  std::filesystem::path input_, fits_, output_;
+  double band_mm_ = 0.1;
+  int resolution_ = 96;
+};
+
+ARTICULA_REGISTER_COMMAND(ErrorsCommand)
+
+}  // namespace
+}  // namespace articula::apps

@@ -1,0 +1,259 @@
+#include "articula/distance/signed_distance.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/LU>
+
+#include "articula/distance/ellipsoid_distance.hpp"
+#include "articula/geometry/pose.hpp"
+
+namespace articula::distance {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+using geometry::ShapeModel;
+
+namespace {
+// F, gradient and Hessian in the shape's rotated but unscaled frame
+// y = R^T (x - t), where Euclidean distances are the global ones.
+struct LocalEvaluation {
+  double value;
+  Vector3d gradient;
+  Matrix3d hessian;
+};
+
+bool isQuadric(ShapeModel m) { return m == ShapeModel::Sphere || m == ShapeModel::Ellipsoid; }
+}  // namespace
+
+SignedDistance::SignedDistance(const geometry::ShapeParameters& shape)
+    : shape_(shape), surface_(geometry::makeSurface(shape)), pose_(surface_->pose()), rotation_(pose_.rotation) {}
+
+void SignedDistance::buildSeeds() const {
+  // Seeds: an exact parametric sample of the surface, and the longest edge
+  // between neighbours, which bounds how far any surface point is from a seed.
+  const geometry::SurfaceMesh mesh = surface_->sample(32, 16);
+  seeds_.resize(mesh.vertices.rows(), 3);
+  for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i)
+    seeds_.row(i) = (rotation_.transpose() * (mesh.vertices.row(i).transpose() - pose_.translation)).transpose();
+  for (Eigen::Index f = 0; f < mesh.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const double edge =
+          (seeds_.row(mesh.triangles(f, k)) - seeds_.row(mesh.triangles(f, (k + 1) % 3))).norm();
+      seed_spacing_ = std::max(seed_spacing_, edge);
+    }
+}
+
+SignedDistance::~SignedDistance() = default;
+SignedDistance::SignedDistance(SignedDistance&&) noexcept = default;
+SignedDistance& SignedDistance::operator=(SignedDistance&&) noexcept = default;
+
+namespace {
+LocalEvaluation evaluateLocal(const geometry::PosedSurface& s, const Vector3d& inv_radii, const Vector3d& y) {
+  const geometry::Evaluation e = s.evaluateCanonical(y.cwiseProduct(inv_radii), 2);
+  return {e.value, e.gradient.cwiseProduct(inv_radii),
+          inv_radii.asDiagonal() * e.hessian * inv_radii.asDiagonal()};
+}
+}  // namespace
+
+Vector3d SignedDistance::radialProjection(const Vector3d& y) const {
+  // Every ray from the local origin (inside: F = -1) leaves the convex body
+  // exactly once: bracket the crossing and refine by Illinois regula falsi.
+  const Vector3d inv_r = pose_.scale.cwiseInverse();
+  const Vector3d u = y.cwiseProduct(inv_r);
+  const double len = u.norm();
+  if (!(len > 0.0)) return Vector3d(0.0, 0.0, pose_.scale[2]);
+  const Vector3d dir = u / len;
+  auto f = [&](double s) { return surface_->evaluateCanonical(s * dir, 0).value; };
+  double lo = 0.0, f_lo = -1.0, hi = 1.0, f_hi = f(hi);
+  while (f_hi <= 0.0) {
+    lo = hi;
+    f_lo = f_hi;
+    hi *= 2.0;
+    f_hi = f(hi);
+  }
+  int side = 0;
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double s = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+    const double fs = f(s);
+    if (fs == 0.0) return (s * dir).cwiseProduct(pose_.scale);
+    if (fs < 0.0) {
+      lo = s;
+      f_lo = fs;
+      if (side == -1) f_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = s;
+      f_hi = fs;
+      if (side == 1) f_lo *= 0.5;
+      side = 1;
+    }
+  }
+  return (0.5 * (lo + hi) * dir).cwiseProduct(pose_.scale);
+}
+
+bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoint& result) const {
+  const Vector3d inv_r = pose_.scale.cwiseInverse();
+  const double scale = pose_.scale.maxCoeff();
+  Vector3d q = start;
+  LocalEvaluation e = evaluateLocal(*surface_, inv_r, q);
+  double mu = (y - q).dot(e.gradient) / e.gradient.squaredNorm();
+  auto merit = [&](const Vector3d& qq, double m, const LocalEvaluation& ee) {
+    return (qq - y + m * ee.gradient).squaredNorm() + ee.value * ee.value / ee.gradient.squaredNorm();
+  };
+  double current = merit(q, mu, e);
+  const double tolerance = 1e-12 * scale;
+  for (int iteration = 0;; ++iteration) {
+    if (current <= tolerance * tolerance) break;
+    if (iteration == 60) return false;
+    Eigen::Matrix4d J;
+    J.topLeftCorner<3, 3>() = Matrix3d::Identity() + mu * e.hessian;
+    J.topRightCorner<3, 1>() = e.gradient;
+    J.bottomLeftCorner<1, 3>() = e.gradient.transpose();
+    J(3, 3) = 0.0;
+    Eigen::Vector4d r;
+    r.head<3>() = q - y + mu * e.gradient;
+    r[3] = e.value;
+    const Eigen::Vector4d step = J.partialPivLu().solve(-r);
+    if (!step.allFinite()) return false;
+    double alpha = 1.0;
+    bool accepted = false;
+    for (int k = 0; k < 30; ++k, alpha *= 0.5) {
+      const Vector3d q_new = q + alpha * step.head<3>();
+      const double mu_new = mu + alpha * step[3];
+      const LocalEvaluation e_new = evaluateLocal(*surface_, inv_r, q_new);
+      const double m_new = merit(q_new, mu_new, e_new);
+      if (m_new < current) {
+        q = q_new;
+        mu = mu_new;
+        e = e_new;
+        current = m_new;
+        accepted = true;
+        break;
+      }
+    }
+    // Stalled: accept only at (near) rounding level.
+    if (!accepted) {
+      if (current > 1e4 * tolerance * tolerance) return false;
+      break;
+    }
+  }
+  const double dist = (y - q).norm();
+  const double f_y = evaluateLocal(*surface_, inv_r, y).value;
+  // A foot point must see y on the correct side of its tangent plane.
+  if (dist > 1e-9 * scale && (mu < 0.0) != (f_y < 0.0)) return false;
+  result.distance = f_y < 0.0 ? -dist : dist;
+  result.point = q;
+  return true;
+}
+
+ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) const {
+  // Safeguard: move along the tangent plane towards y and project back
+  // radially; accept only shorter distances (slow, but cannot diverge).
+  const Vector3d inv_r = pose_.scale.cwiseInverse();
+  Vector3d q = radialProjection(start);
+  double best = (y - q).norm();
+  double alpha = 0.5;
+  for (int i = 0; i < 2000 && alpha > 1e-12; ++i) {
+    const Vector3d n = evaluateLocal(*surface_, inv_r, q).gradient.normalized();
+    const Vector3d v = y - q;
+    const Vector3d tangent = v - v.dot(n) * n;
+    if (tangent.norm() <= 1e-14 * pose_.scale.maxCoeff()) break;
+    const Vector3d candidate = radialProjection(q + alpha * tangent);
+    const double dist = (y - candidate).norm();
+    if (dist < best) {
+      q = candidate;
+      best = dist;
+      alpha = std::min(1.0, alpha * 1.5);
+    } else {
+      alpha *= 0.5;
+    }
+  }
+  ClosestPoint result;
+  result.point = q;
+  result.distance = evaluateLocal(*surface_, inv_r, y).value < 0.0 ? -best : best;
+  return result;
+}
+
+ClosestPoint SignedDistance::closest(const Vector3d& x) const {
+  ClosestPoint result;
+  if (shape_.model == ShapeModel::Sphere) {
+    const Vector3d v = x - shape_.center;
+    const double len = v.norm();
+    const Vector3d dir = len > 0.0 ? Vector3d(v / len) : Vector3d::UnitZ();
+    result.distance = len - shape_.radii[0];
+    result.point = shape_.center + shape_.radii[0] * dir;
+    return result;
+  }
+  const Vector3d y = rotation_.transpose() * (x - pose_.translation);
+  if (shape_.model == ShapeModel::Ellipsoid) {
+    Vector3d q;
+    result.distance = ellipsoidClosestPoint(pose_.scale, y, q);
+    result.point = rotation_ * q + pose_.translation;
+    return result;
+  }
+  if (seeds_.rows() == 0) buildSeeds();
+  // Nearest seed first.
+  Eigen::Index nearest = 0;
+  const Eigen::VectorXd seed_d2 = (seeds_.rowwise() - y.transpose()).rowwise().squaredNorm();
+  seed_d2.minCoeff(&nearest);
+  auto solve = [&](const Vector3d& start) {
+    ClosestPoint c;
+    if (!newton(y, start, c)) c = descent(y, start);
+    return c;
+  };
+  ClosestPoint best = solve(seeds_.row(nearest).transpose());
+  // Any nearer local minimum lies within one seed spacing of some seed that
+  // is closer than |d| + spacing to y: try those far from minima already found.
+  const double h = seed_spacing_;
+  std::vector<Vector3d> found{best.point};
+  const double reach = std::fabs(best.distance) + h;
+  for (Eigen::Index i = 0; i < seeds_.rows(); ++i) {
+    if (seed_d2[i] >= reach * reach) continue;
+    const Vector3d s = seeds_.row(i).transpose();
+    bool near_known = false;
+    for (const Vector3d& f : found)
+      if ((s - f).squaredNorm() < 4.0 * h * h) near_known = true;
+    if (near_known) continue;
+    const ClosestPoint c = solve(s);
+    found.push_back(s);
+    found.push_back(c.point);
+    if (std::fabs(c.distance) < std::fabs(best.distance)) best = c;
+  }
+  best.point = rotation_ * best.point + pose_.translation;
+  return best;
+}
+
+ClosestPoint SignedDistance::closestFrom(const Vector3d& x, const Vector3d& guess) const {
+  if (isQuadric(shape_.model)) return closest(x);
+  const Vector3d y = rotation_.transpose() * (x - pose_.translation);
+  ClosestPoint c;
+  if (!newton(y, rotation_.transpose() * (guess - pose_.translation), c)) return closest(x);
+  c.point = rotation_ * c.point + pose_.translation;
+  return c;
+}
+
+void SignedDistance::evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d, Eigen::MatrixX3d& feet,
+                              bool warm) const {
+  const Eigen::Index n = points.rows();
+  d.resize(n);
+  if (!warm || feet.rows() != n) {
+    warm = false;
+    feet.resize(n, 3);
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vector3d x = points.row(i).transpose();
+    const ClosestPoint c = warm ? closestFrom(x, feet.row(i).transpose()) : closest(x);
+    d[i] = c.distance;
+    feet.row(i) = c.point.transpose();
+  }
+}
+
+Eigen::VectorXd signedDistances(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points) {
+  Eigen::VectorXd d;
+  Eigen::MatrixX3d feet;
+  SignedDistance(shape).evaluate(points, d, feet);
+  return d;
+}
+
+}  // namespace articula::distance

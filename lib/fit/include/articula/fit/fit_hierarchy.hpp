@@ -1,0 +1,92 @@
+#pragma once
+// Fitting the hierarchy sphere -> ellipsoid -> {superellipsoid, ovoid} ->
+// superovoid (thesis fig. 3.2) to a point cloud with NLopt, Ceres-style:
+// an Options struct validated before use and a Summary with the
+// termination reason of every model.
+//
+// Every child starts at its parent's optimum (which it contains exactly) and
+// keeps the best point it evaluates, so each model's RMS signed Euclidean
+// distance is <= its parent's (the nesting guarantee; checked on the exact
+// distances after fitting, falling back to the parent's shape otherwise).
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "articula/geometry/shape.hpp"
+
+namespace articula::fit {
+
+enum class Objective {
+  Algebraic,  // thesis eq. 3.1: sum of F(x_i)^2 (F = 0 on the surface)
+  Geometric,  // orthogonal distance fitting: sum of squared signed Euclidean distances
+};
+std::string objectiveName(Objective o);
+/// "algebraic" or "geometric"; throws UsageError otherwise.
+Objective objectiveFromName(const std::string& name);
+
+enum class Strategy {
+  Local,        // LN_BOBYQA from the hierarchical start
+  GlobalLocal,  // GN_CRS2_LM within the bounds (seeded, capped), then LN_BOBYQA
+};
+std::string strategyName(Strategy s);
+Strategy strategyFromName(const std::string& name);
+
+struct Options {
+  std::vector<geometry::ShapeModel> models = geometry::allModels();  // what to report (ancestors are fitted anyway)
+  Objective objective = Objective::Geometric;
+  Strategy strategy = Strategy::Local;
+  std::string local_algorithm = "LD_SLSQP";  // or LN_BOBYQA, LD_LBFGS, LD_MMA, LD_TNEWTON_PRECOND_RESTART
+  unsigned seed = 42;                  // NLopt's random seed (CRS2)
+  int max_evaluations = 4000;          // per local run
+  int global_evaluations = 3000;       // per global run (GlobalLocal)
+  int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
+  int screening_evaluations = 40;      // ovoid: per axis labelling of the ellipsoid, before the best is finished
+  double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
+  double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
+  // Bounds (thesis section 3.2.5), around the reference ellipsoid start:
+  double radius_interval = 0.5;        // radii in [(1 - r) a_min, (1 + r) a_max]
+  double center_interval = 0.5;        // centre within this fraction of the largest radius
+  double exponent_min = 2.0, exponent_max = 4.0;
+  double c01_min = 0.0, c01_max = 1.0;    // c0, c1
+  double c23_min = -0.1, c23_max = 0.1;   // c2, c3
+  /// Overrides by parameter name of table 3.2 ("a", "gamma1", "c2x", "t1", ...).
+  std::map<std::string, std::pair<double, double>> bounds;
+
+  /// Throws UsageError naming the first bad field.
+  void validate() const;
+};
+
+struct ModelFit {
+  geometry::ShapeParameters parameters;
+  std::string started_from;        // "algebraic", or the parent model(s) tried
+  double rms_mm = 0.0;             // RMS of the exact signed Euclidean distances
+  double sse_mm2 = 0.0;            // sum of their squares (geometric objective)
+  double algebraic_objective = 0.0;  // eq. 3.1 at the result
+  int evaluations = 0;
+  double seconds = 0.0;
+  std::string termination;         // NLopt's reason, or why the parent was kept
+  bool converged = false;
+};
+
+struct Summary {
+  std::vector<ModelFit> fits;      // in hierarchy order, only the requested models
+  std::string best_model;          // lowest RMS; ties go to the simpler model
+  int points = 0;
+  double seconds = 0.0;
+  std::string briefReport() const;
+  std::string fullReport() const;
+  const ModelFit& fit(geometry::ShapeModel model) const;  // throws UsageError if absent
+};
+
+/// Fits `points` (#P x 3, LPS mm). Throws UsageError for bad options and
+/// ProcessingError if no start can be found (degenerate points).
+Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& options = {});
+
+/// The thesis objective eq. 3.1 and the geometric SSE (mm^2) of a shape.
+double algebraicObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
+double geometricObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
+
+}  // namespace articula::fit

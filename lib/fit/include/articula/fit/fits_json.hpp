@@ -1,0 +1,22 @@
+#pragma once
+// The fits.json contract (issue 3): one entry of `models` per fitted model
+// with "model", "center_mm", "radii_mm", "rotation_deg" [phi, theta, psi],
+// "rotation_matrix", "exponents", "cx", "cy", objective values and the
+// optimiser's report; plus top-level "best_model".
+#include <nlohmann/json.hpp>
+
+#include "articula/fit/fit_hierarchy.hpp"
+
+namespace articula::fit {
+
+/// One entry of fits.json "models".
+nlohmann::json modelFitJson(const ModelFit& fit);
+
+/// The shape of one fits.json "models" entry; throws InputError naming the
+/// missing or malformed key and `where` (e.g. the file name and index).
+geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where);
+
+/// Every shape of a fits.json document, in file order.
+std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where);
+
+}  // namespace articula::fit

@@ -1,0 +1,97 @@
+#include "articula/fit/fits_json.hpp"
+
+#include <cmath>
+
+#include "articula/core/error.hpp"
+#include "articula/geometry/pose.hpp"
+
+namespace articula::fit {
+
+using geometry::ShapeModel;
+
+namespace {
+template <typename Vec>
+std::vector<double> list(const Vec& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+template <int N>
+Eigen::Matrix<double, N, 1> vectorAt(const nlohmann::json& entry, const char* key, const std::string& where) {
+  if (!entry.contains(key)) throw InputError(where + ": missing key \"" + key + "\"");
+  const nlohmann::json& v = entry.at(key);
+  if (!v.is_array() || v.size() != N)
+    throw InputError(where + ": \"" + key + "\" expected an array of " + std::to_string(N) + " numbers, found " +
+                     v.dump());
+  Eigen::Matrix<double, N, 1> out;
+  for (int i = 0; i < N; ++i) {
+    if (!v[static_cast<size_t>(i)].is_number())
+      throw InputError(where + ": \"" + key + "\" expected numbers, found " + v.dump());
+    out[i] = v[static_cast<size_t>(i)].get<double>();
+  }
+  return out;
+}
+}  // namespace
+
+nlohmann::json modelFitJson(const ModelFit& f) {
+  const geometry::ShapeParameters& p = f.parameters;
+  const Eigen::Vector3d radii = p.model == ShapeModel::Sphere ? Eigen::Vector3d::Constant(p.radii[0]) : p.radii;
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(p.angles);
+  nlohmann::json parameters = nlohmann::json::object();
+  const auto names = geometry::parameterNames(p.model);
+  const Eigen::VectorXd lambda = geometry::toVector(p);
+  for (size_t i = 0; i < names.size(); ++i) parameters[names[i]] = lambda[static_cast<Eigen::Index>(i)];
+  return {{"model", geometry::modelName(p.model)},
+          {"center_mm", list(p.center)},
+          {"radii_mm", list(radii)},
+          {"rotation_deg", list(Eigen::Vector3d(p.angles * (180.0 / M_PI)))},
+          {"rotation_matrix", {list(Eigen::Vector3d(R.row(0))), list(Eigen::Vector3d(R.row(1))),
+                               list(Eigen::Vector3d(R.row(2)))}},
+          {"exponents", list(p.exponents)},
+          {"cx", list(p.cx)},
+          {"cy", list(p.cy)},
+          {"parameters_table_3_2", parameters},
+          {"rms_mm", f.rms_mm},
+          {"geometric_objective_mm2", f.sse_mm2},
+          {"algebraic_objective", f.algebraic_objective},
+          {"evaluations", f.evaluations},
+          {"seconds", f.seconds},
+          {"started_from", f.started_from},
+          {"termination", f.termination},
+          {"converged", f.converged}};
+}
+
+geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where) {
+  if (!entry.is_object()) throw InputError(where + ": expected an object, found " + entry.dump());
+  if (!entry.contains("model") || !entry.at("model").is_string())
+    throw InputError(where + ": missing string key \"model\"");
+  geometry::ShapeParameters p;
+  try {
+    p.model = geometry::modelFromName(entry.at("model").get<std::string>());
+  } catch (const UsageError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  p.center = vectorAt<3>(entry, "center_mm", where);
+  p.radii = vectorAt<3>(entry, "radii_mm", where);
+  p.angles = vectorAt<3>(entry, "rotation_deg", where) * (M_PI / 180.0);
+  p.exponents = vectorAt<3>(entry, "exponents", where);
+  p.cx = vectorAt<4>(entry, "cx", where);
+  p.cy = vectorAt<4>(entry, "cy", where);
+  try {
+    geometry::validate(p);
+  } catch (const InvalidParameter& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  return p;
+}
+
+std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where) {
+  if (!document.is_object() || !document.contains("models") || !document.at("models").is_array() ||
+      document.at("models").empty())
+    throw InputError(where + ": expected a fits.json object with a non-empty array \"models\"");
+  std::vector<geometry::ShapeParameters> shapes;
+  for (size_t i = 0; i < document.at("models").size(); ++i)
+    shapes.push_back(shapeFromJson(document.at("models")[i], where + ": models[" + std::to_string(i) + "]"));
+  return shapes;
+}
+
+}  // namespace articula::fit
