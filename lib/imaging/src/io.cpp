@@ -299,6 +299,7 @@ void writeDicomSeries(const fs::path& folder, const Volume& volume, const std::s
     put("0020|0037", num(r[0]) + "\\" + num(r[1]) + "\\" + num(r[2]) + "\\" + num(c[0]) + "\\" + num(c[1]) + "\\" + num(c[2]));
     put("0018|0050", num(g.spacing[2]));
     put("0028|0030", num(g.spacing[1]) + "\\" + num(g.spacing[0]));  // row spacing \ column spacing
+    put("0028|0004", "MONOCHROME2");
     put("0028|1052", "0");
     put("0028|1053", "1");
     dict_ptrs.push_back(&d);

@@ -6,9 +6,10 @@
 #include <sstream>
 
 #include <itkBinaryFillholeImageFilter.h>
+#include <itkBlackTopHatImageFilter.h>
+#include <itkFlatStructuringElement.h>
 #include <itkMorphologicalWatershedFromMarkersImageFilter.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
-#include <itkSmoothingRecursiveGaussianImageFilter.h>
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
@@ -62,8 +63,7 @@ Image<T> crop(const Image<T>& image, const Eigen::Vector3i& lo, const Eigen::Vec
 }
 
 /// Automatic head search: the deepest point of the filled bone mask, on a grid
-/// of about options.search_spacing_mm (blocks pooled with "any bone", which
-/// also seals small gaps in a thin cortex), on the requested side of the
+/// of about options.search_spacing_mm, on the requested side of the
 /// volume's centre, with a depth that a joint head can have.
 bool findHead(const Mask& mask, const SegmentOptions& options, Eigen::Vector3d& center, double& depth) {
   const ImageGeometry& g = mask.geometry;
@@ -76,11 +76,15 @@ bool findHead(const Mask& mask, const SegmentOptions& options, Eigen::Vector3d& 
   coarse.geometry.spacing = g.spacing.cwiseProduct(factor.cast<double>());
   // Block (0,0,0) covers voxels 0..f-1: its centre is at index (f-1)/2.
   coarse.geometry.origin = g.toPhysical((factor.cast<double>() - Eigen::Vector3d::Ones()) / 2.0);
-  coarse.voxels.assign(static_cast<size_t>(coarse.geometry.voxelCount()), 0);
+  // Majority pooling: "any bone" would bridge the joint gap.
+  std::vector<int> count(static_cast<size_t>(coarse.geometry.voxelCount()), 0);
   for (int k = 0; k < g.size[2]; ++k)
     for (int j = 0; j < g.size[1]; ++j)
       for (int i = 0; i < g.size[0]; ++i)
-        if (mask.at(i, j, k)) coarse.at(i / factor[0], j / factor[1], k / factor[2]) = 1;
+        if (mask.at(i, j, k)) ++count[static_cast<size_t>(coarse.geometry.linear(i / factor[0], j / factor[1], k / factor[2]))];
+  const int block = factor.prod();
+  coarse.voxels.resize(count.size());
+  for (size_t n = 0; n < count.size(); ++n) coarse.voxels[n] = 2 * count[n] >= block ? 1 : 0;
   const Image<float> distance = signedDistance(fillHoles(coarse));
   const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
   const double lo = 0.6 * options.min_head_radius_mm, hi = options.max_head_radius_mm;
@@ -98,6 +102,44 @@ bool findHead(const Mask& mask, const SegmentOptions& options, Eigen::Vector3d& 
         center = x;
       }
   return depth > 0;
+}
+
+/// Marker watershed on the signed distance to the bone surface: the head's
+/// centre is a deep basin, and the bone bridges across the joint gap and the
+/// head-neck junction are saddles where the head region stops. Markers: the
+/// head core (ball of 0.85 r), far bone (beyond 1.35 r: socket, pelvis, shaft)
+/// and everything outside the bone mask.
+Mask watershedHead(const Image<float>& distance, const Mask& bone, const Eigen::Vector3d& center, double r) {
+  const ImageGeometry& bg = bone.geometry;
+  Image<unsigned> markers;
+  markers.geometry = bg;
+  markers.voxels.assign(bone.voxels.size(), 0);
+  long long head_marker = 0;
+  for (int k = 0; k < bg.size[2]; ++k)
+    for (int j = 0; j < bg.size[1]; ++j)
+      for (int i = 0; i < bg.size[0]; ++i) {
+        const double d = (bg.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm();
+        unsigned& m = markers.at(i, j, k);
+        if (!bone.at(i, j, k)) m = 3;
+        else if (d < 0.85 * r) m = 1, ++head_marker;
+        else if (d > 1.35 * r) m = 2;
+      }
+  if (head_marker == 0)
+    throw ProcessingError("the seed " + vec(center) + " mm is not inside bone in the HU window");
+  using FloatImage = itk::Image<float, 3>;
+  using LabelImage = itk::Image<unsigned, 3>;
+  auto watershed = itk::MorphologicalWatershedFromMarkersImageFilter<FloatImage, LabelImage>::New();
+  watershed->SetInput(toItk(distance));
+  watershed->SetMarkerImage(toItk(markers));
+  watershed->SetMarkWatershedLine(false);
+  watershed->SetFullyConnected(false);
+  watershed->Update();
+  const Image<unsigned> regions = fromItk<unsigned>(watershed->GetOutput());
+  Mask head;
+  head.geometry = bg;
+  head.voxels.resize(regions.voxels.size());
+  for (size_t n = 0; n < regions.voxels.size(); ++n) head.voxels[n] = regions.voxels[n] == 1 && bone.voxels[n];
+  return fillHoles(head);
 }
 
 }  // namespace
@@ -179,60 +221,66 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   }
   lo = lo.cwiseMax(0);
   hi = hi.cwiseMin(g.size - Eigen::Vector3i::Ones());
-  const Mask box_mask = fillHoles(crop(mask, lo, hi));
-  const Volume box_hu = crop(volume, lo, hi);
+  // The joint gap is a narrow dark valley between two bright cortices; where
+  // partial volume lifts it into the HU window, the black top-hat (closing
+  // minus image) finds it, and those voxels leave the bone mask.
+  Mask box_raw = crop(mask, lo, hi);
+  if (options.gap_contrast_hu > 0) {
+    const Volume box_hu = crop(volume, lo, hi);
+    using FloatImage = itk::Image<float, 3>;
+    using Ball = itk::FlatStructuringElement<3>;
+    Ball::RadiusType radius;
+    for (unsigned a = 0; a < 3; ++a)
+      radius[a] = static_cast<itk::SizeValueType>(std::max(1.0, std::ceil(options.gap_width_mm / 2 / box_hu.geometry.spacing[static_cast<int>(a)])));
+    auto tophat = itk::BlackTopHatImageFilter<FloatImage, FloatImage, Ball>::New();
+    tophat->SetInput(toItk(box_hu));
+    tophat->SetKernel(Ball::Ball(radius));
+    tophat->Update();
+    const Image<float> valley = fromItk<float>(tophat->GetOutput());
+    long long removed = 0;
+    for (size_t n = 0; n < box_raw.voxels.size(); ++n)
+      if (box_raw.voxels[n] && valley.voxels[n] > options.gap_contrast_hu) box_raw.voxels[n] = 0, ++removed;
+    log::debug("joint-gap valley: " + std::to_string(removed) + " voxels removed from the bone mask");
+  }
+  const Mask box_mask = fillHoles(box_raw);
   const ImageGeometry& bg = box_mask.geometry;
-
-  // 4. Markers: head core, far bone (socket, pelvis, shaft), soft tissue.
-  const double r = depth;
-  Image<unsigned> markers;
-  markers.geometry = bg;
-  markers.voxels.assign(box_mask.voxels.size(), 0);
-  long long head_marker = 0;
-  for (int k = 0; k < bg.size[2]; ++k)
-    for (int j = 0; j < bg.size[1]; ++j)
-      for (int i = 0; i < bg.size[0]; ++i) {
-        const double d = (bg.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm();
-        unsigned& m = markers.at(i, j, k);
-        if (!box_mask.at(i, j, k)) m = 3;
-        else if (d < 0.5 * r) m = 1, ++head_marker;
-        else if (d > 1.35 * r) m = 2;
-      }
-  if (head_marker == 0)
-    throw ProcessingError("the seed " + vec(center) + " mm is not inside bone in the HU window");
-
-  // 5. Watershed on the smoothed, negated intensity: the head's cortex is a
-  //    basin, the joint gap a ridge even where partial volume bridges it.
-  using FloatImage = itk::Image<float, 3>;
-  using LabelImage = itk::Image<unsigned, 3>;
-  auto smooth = itk::SmoothingRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
-  Volume negated = box_hu;
-  for (float& v : negated.voxels) v = -std::clamp(v, static_cast<float>(options.hu_min - 500), static_cast<float>(options.hu_max));
-  smooth->SetInput(toItk(negated));
-  smooth->SetSigma(0.5 * bg.spacing.minCoeff());
-  auto watershed = itk::MorphologicalWatershedFromMarkersImageFilter<FloatImage, LabelImage>::New();
-  watershed->SetInput(smooth->GetOutput());
-  watershed->SetMarkerImage(toItk(markers));
-  watershed->SetMarkWatershedLine(false);
-  watershed->SetFullyConnected(false);
-  watershed->Update();
-  const Image<unsigned> regions = fromItk<unsigned>(watershed->GetOutput());
-  Mask head;
-  head.geometry = bg;
-  head.voxels.resize(regions.voxels.size());
-  for (size_t n = 0; n < regions.voxels.size(); ++n) head.voxels[n] = regions.voxels[n] == 1 && box_mask.voxels[n];
-  head = fillHoles(head);
-
-  // 6. Deepest point of the head label: its centre and (about) its radius.
-  const Image<float> head_distance = signedDistance(head);
-  double best = 0;
-  for (int k = 0; k < bg.size[2]; ++k)
-    for (int j = 0; j < bg.size[1]; ++j)
-      for (int i = 0; i < bg.size[0]; ++i)
-        if (-head_distance.at(i, j, k) > best) {
-          best = -head_distance.at(i, j, k);
-          summary.head_center_mm = bg.toPhysical(Eigen::Vector3d(i, j, k));
+  const Image<float> box_distance = signedDistance(box_mask);
+  {
+    // Re-centre on the deepest full-resolution bone near the search's centre:
+    // the coarse grid can bridge a narrow joint gap and shift it.
+    const Eigen::Vector3d start = center;
+    double deepest = 0;
+    for (int k = 0; k < bg.size[2]; ++k)
+      for (int j = 0; j < bg.size[1]; ++j)
+        for (int i = 0; i < bg.size[0]; ++i) {
+          const Eigen::Vector3d x = bg.toPhysical(Eigen::Vector3d(i, j, k));
+          if ((x - start).norm() < 0.5 * depth && -box_distance.at(i, j, k) > deepest) {
+            deepest = -box_distance.at(i, j, k);
+            center = x;
+          }
         }
+    if (deepest > 0) depth = deepest;
+  }
+
+  // 4-6. Watershed from markers, then re-centred once on the label's deepest
+  //      point (the search's centre can sit off-centre where bone is joined).
+  Mask head;
+  double best = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double r = pass == 0 ? depth : best;
+    if (pass == 1) center = summary.head_center_mm;
+    head = watershedHead(box_distance, box_mask, center, r);
+    const Image<float> head_distance = signedDistance(head);
+    best = 0;
+    for (int k = 0; k < bg.size[2]; ++k)
+      for (int j = 0; j < bg.size[1]; ++j)
+        for (int i = 0; i < bg.size[0]; ++i)
+          if (-head_distance.at(i, j, k) > best) {
+            best = -head_distance.at(i, j, k);
+            summary.head_center_mm = bg.toPhysical(Eigen::Vector3d(i, j, k));
+          }
+    if (best < 0.5 * options.min_head_radius_mm) break;  // no head to re-centre on
+  }
   summary.head_depth_mm = best;
   if (best < 0.5 * options.min_head_radius_mm)
     summary.warnings.push_back("the labelled head is thin (depth " + std::to_string(best) +

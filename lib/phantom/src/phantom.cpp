@@ -138,8 +138,9 @@ Phantom makePhantom(const PhantomOptions& o) {
   a.gap = o.gap_mm;
 
   // The grid: head, socket and pelvis medially, neck and shaft laterally.
-  const Vector3d lo(std::min(a.center[0] + s * 75.0, a.center[0] - s * 45.0), a.center[1] - 55.0, a.center[2] - 75.0);
-  const Vector3d hi(std::max(a.center[0] + s * 75.0, a.center[0] - s * 45.0), a.center[1] + 55.0, a.center[2] + 50.0);
+  // Lateral 60 mm, medial 80 mm: the head lies on its side of the grid's centre.
+  const Vector3d lo(std::min(a.center[0] + s * 60.0, a.center[0] - s * 80.0), a.center[1] - 55.0, a.center[2] - 75.0);
+  const Vector3d hi(std::max(a.center[0] + s * 60.0, a.center[0] - s * 80.0), a.center[1] + 55.0, a.center[2] + 50.0);
   imaging::ImageGeometry g;
   g.spacing = o.spacing;
   for (int ax = 0; ax < 3; ++ax) g.size[ax] = static_cast<int>(std::ceil((hi[ax] - lo[ax]) / o.spacing[ax])) + 1;

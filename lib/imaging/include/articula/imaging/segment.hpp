@@ -2,8 +2,8 @@
 // Segmentation of one joint head (femoral or humeral) from a CT volume:
 // HU threshold, optional ROI, hole filling, automatic head finding (the
 // deepest bone point on the chosen side, on a ~2 mm grid), then a marker
-// watershed on the smoothed intensity that cuts the head from the socket
-// along the dark joint gap even where the threshold bridges it.
+// watershed on the distance to the bone surface, which cuts the head from
+// the socket and the neck at the narrow bone bridges between them.
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +27,8 @@ struct SegmentOptions {
   double min_head_radius_mm = 15.0;                 // plausible joint heads
   double max_head_radius_mm = 35.0;
   double search_spacing_mm = 2.0;                   // grid of the automatic head search
+  double gap_width_mm = 4.0;     // widest joint gap the valley filter closes
+  double gap_contrast_hu = 300;  // black top-hat above which a voxel is gap, not bone (0: off)
   /// Throws UsageError naming the first invalid option.
   void validate() const;
 };
