@@ -1,0 +1,64 @@
+#pragma once
+// Reading CT volumes and labels (DICOM series, NIfTI, NRRD, MHA) with the
+// checks ITK does not make, and writing them back. Everything in LPS mm.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "articula/imaging/image.hpp"
+
+namespace articula::imaging {
+
+/// One DICOM series found in a folder.
+struct SeriesInfo {
+  std::string uid;          // GDCM series identifier (Series Instance UID, possibly with details)
+  std::string modality;     // (0008,0060)
+  std::string description;  // (0008,103E)
+  int files = 0;
+};
+
+struct ReadOptions {
+  std::string series_uid;                  // empty: the largest CT series (logged)
+  double spacing_tolerance = 0.01;         // relative deviation of slice gaps tolerated
+  double tilt_tolerance_deg = 0.1;         // gantry tilt above which we refuse
+};
+
+/// What reading found: series, slice spacing, warnings; goes to the sidecar JSON.
+struct ReadReport {
+  std::string source;       // "dicom" or "file"
+  std::string series_uid;
+  std::string modality;
+  std::vector<SeriesInfo> series;  // every series of the folder
+  double slice_spacing_mm = 0;     // measured from Image Position Patient
+  double slice_spacing_spread_mm = 0;
+  double gantry_tilt_deg = 0;
+  std::vector<std::string> warnings;
+};
+
+/// Lists the DICOM series in `folder`; throws InputError if there is none.
+std::vector<SeriesInfo> listDicomSeries(const std::filesystem::path& folder);
+
+/// Reads a CT volume in HU from a DICOM folder or an image file (.nii, .nii.gz,
+/// .nrrd, .nhdr, .mha, .mhd). Throws InputError (exit 3) for an empty or
+/// non-DICOM folder, several series without options.series_uid, non-uniform
+/// slice spacing or missing slices, gantry tilt, a non-CT modality, or a
+/// non-orthonormal direction matrix.
+Volume readVolume(const std::filesystem::path& input, const ReadOptions& options, ReadReport* report = nullptr);
+
+/// Reads a label image (any integer type, non-zero = 1).
+Label readLabel(const std::filesystem::path& input);
+
+/// Writes a volume (as int16 HU) or a label (uint8) to .nii.gz/.nii/.nrrd/.mha,
+/// atomically (temporary name, then rename).
+void writeVolume(const std::filesystem::path& path, const Volume& volume, bool overwrite = true);
+void writeLabel(const std::filesystem::path& path, const Label& label, bool overwrite = true);
+
+/// Writes a CT DICOM series (int16, rescale slope 1, intercept 0) as
+/// folder/slice_0000.dcm ..., one file per k, with Image Position/Orientation
+/// Patient from the geometry and modality CT.
+void writeDicomSeries(const std::filesystem::path& folder, const Volume& volume, const std::string& series_description);
+
+/// Throws InputError unless `direction` is orthonormal within 1e-3.
+void checkDirection(const Eigen::Matrix3d& direction, const std::string& where);
+
+}  // namespace articula::imaging

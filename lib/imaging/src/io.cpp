@@ -1,0 +1,324 @@
+// ITK reading and writing of CT volumes and labels. ITK bundles its own Eigen
+// under the system Eigen's include guards: image.hpp (system Eigen) comes first.
+#include "articula/imaging/io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <unistd.h>
+
+#include <gdcmUIDGenerator.h>
+#include <itkGDCMImageIO.h>
+#include <itkGDCMSeriesFileNames.h>
+#include <itkImage.h>
+#include <itkImageFileReader.h>
+#include <itkImageFileWriter.h>
+#include <itkImageSeriesReader.h>
+#include <itkImageSeriesWriter.h>
+#include <itkMetaDataObject.h>
+
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+#include "itk_bridge.hpp"
+
+namespace articula::imaging {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string tagValue(const itk::MetaDataDictionary& dict, const std::string& tag) {
+  std::string value;
+  itk::ExposeMetaData<std::string>(dict, tag, value);
+  // DICOM pads strings to even length with spaces or NULs.
+  while (!value.empty() && (value.back() == ' ' || value.back() == '\0')) value.pop_back();
+  return value;
+}
+
+std::vector<double> parseNumbers(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, '\\')) {
+    try {
+      out.push_back(std::stod(item));
+    } catch (const std::exception&) {
+      return {};
+    }
+  }
+  return out;
+}
+
+/// Modality and description of a series from its first file's header.
+void readHeader(const std::string& file, std::string& modality, std::string& description) {
+  auto io = itk::GDCMImageIO::New();
+  io->SetFileName(file);
+  io->ReadImageInformation();
+  modality = tagValue(io->GetMetaDataDictionary(), "0008|0060");
+  description = tagValue(io->GetMetaDataDictionary(), "0008|103e");
+}
+
+std::string seriesList(const std::vector<SeriesInfo>& series) {
+  std::string out;
+  for (const auto& s : series)
+    out += "\n  " + s.uid + "  modality " + (s.modality.empty() ? "?" : s.modality) + ", " +
+           std::to_string(s.files) + " files" + (s.description.empty() ? "" : ", '" + s.description + "'");
+  return out;
+}
+
+bool isImageFile(const fs::path& p) {
+  const std::string name = p.filename().string();
+  for (const char* ext : {".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd"})
+    if (name.size() > std::strlen(ext) && name.compare(name.size() - std::strlen(ext), std::string::npos, ext) == 0)
+      return true;
+  return false;
+}
+
+/// Measures slice gaps and gantry tilt from Image Position/Orientation Patient
+/// of every slice, refusing gaps or tilt that ITK would silently mis-place.
+void checkSlices(const std::vector<std::string>& files, const itk::ImageSeriesReader<itk::Image<float, 3>>& reader,
+                 const ReadOptions& options, ReadReport& report, double& spacing_out) {
+  const auto* dicts = reader.GetMetaDataDictionaryArray();
+  if (!dicts || dicts->size() != files.size()) throw InputError("DICOM series: could not read the slice headers");
+  const std::vector<double> iop = parseNumbers(tagValue(*(*dicts)[0], "0020|0037"));
+  if (iop.size() != 6) throw InputError("DICOM series: missing Image Orientation Patient (0020,0037) in " + files[0]);
+  const Eigen::Vector3d row(iop[0], iop[1], iop[2]), col(iop[3], iop[4], iop[5]);
+  const Eigen::Vector3d normal = row.cross(col).normalized();
+  std::vector<Eigen::Vector3d> positions;
+  for (size_t k = 0; k < files.size(); ++k) {
+    const std::vector<double> ipp = parseNumbers(tagValue(*(*dicts)[k], "0020|0032"));
+    if (ipp.size() != 3) throw InputError("DICOM series: missing Image Position Patient (0020,0032) in " + files[k]);
+    positions.emplace_back(ipp[0], ipp[1], ipp[2]);
+  }
+  if (positions.size() < 2) throw InputError("DICOM series: a volume needs at least 2 slices, found 1 (" + files[0] + ")");
+  std::vector<double> gaps;
+  for (size_t k = 0; k + 1 < positions.size(); ++k) gaps.push_back(normal.dot(positions[k + 1] - positions[k]));
+  std::vector<double> sorted = gaps;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  if (std::fabs(median) < 1e-6) throw InputError("DICOM series: slices share one position (duplicated slices?) in " + files[0]);
+  double spread = 0;
+  for (size_t k = 0; k < gaps.size(); ++k) {
+    spread = std::max(spread, std::fabs(gaps[k] - median));
+    if (std::fabs(gaps[k] - median) > options.spacing_tolerance * std::fabs(median) + 1e-3) {
+      std::ostringstream m;
+      m << "DICOM series: non-uniform slice spacing: expected " << std::fabs(median) << " mm between slices, found "
+        << std::fabs(gaps[k]) << " mm between " << fs::path(files[k]).filename().string() << " and "
+        << fs::path(files[k + 1]).filename().string() << (std::fabs(gaps[k]) > 1.5 * std::fabs(median) ? " (missing slice?)" : "");
+      throw InputError(m.str());
+    }
+  }
+  const Eigen::Vector3d span = positions.back() - positions.front();
+  const double tilt = std::acos(std::min(1.0, std::fabs(span.normalized().dot(normal)))) * 180.0 / M_PI;
+  report.gantry_tilt_deg = tilt;
+  if (tilt > options.tilt_tolerance_deg) {
+    std::ostringstream m;
+    m << "DICOM series: gantry tilt of " << tilt << " degrees (slice positions do not follow the slice normal); "
+      << "ITK would place the slices sheared. Resample the series to an orthogonal grid first.";
+    throw InputError(m.str());
+  }
+  report.slice_spacing_mm = std::fabs(median);
+  report.slice_spacing_spread_mm = spread;
+  spacing_out = std::fabs(median);
+}
+
+Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport& report) {
+  report.source = "dicom";
+  report.series = listDicomSeries(folder);
+  auto names = itk::GDCMSeriesFileNames::New();
+  names->SetUseSeriesDetails(false);
+  names->SetDirectory(folder.string());
+  const SeriesInfo* chosen = nullptr;
+  if (!options.series_uid.empty()) {
+    for (const auto& s : report.series)
+      if (s.uid == options.series_uid) chosen = &s;
+    if (!chosen)
+      throw InputError("--series-uid " + options.series_uid + " not found in " + folder.string() +
+                       "; series found:" + seriesList(report.series));
+  } else {
+    std::vector<const SeriesInfo*> ct;
+    for (const auto& s : report.series)
+      if (s.modality == "CT" || s.modality.empty()) ct.push_back(&s);
+    if (ct.empty())
+      throw InputError("expected a CT series in " + folder.string() + ", found only other modalities:" +
+                       seriesList(report.series));
+    if (ct.size() > 1)
+      throw InputError("several CT series in " + folder.string() + "; choose one with --series-uid:" +
+                       seriesList(report.series));
+    chosen = ct.front();
+    if (report.series.size() > 1) log::info("using the CT series " + chosen->uid + " (" + std::to_string(chosen->files) + " files)");
+  }
+  if (!chosen->modality.empty() && chosen->modality != "CT")
+    throw InputError("expected modality CT, found " + chosen->modality + " in series " + chosen->uid + " of " +
+                     folder.string());
+  if (chosen->modality.empty()) report.warnings.push_back("series has no Modality tag; assumed CT");
+  report.series_uid = chosen->uid;
+  report.modality = chosen->modality;
+
+  const std::vector<std::string> files = names->GetFileNames(chosen->uid);
+  using ReaderType = itk::ImageSeriesReader<itk::Image<float, 3>>;
+  auto reader = ReaderType::New();
+  auto io = itk::GDCMImageIO::New();
+  reader->SetImageIO(io);
+  reader->SetFileNames(files);
+  reader->MetaDataDictionaryArrayUpdateOn();
+  try {
+    reader->Update();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("could not decode the DICOM series " + chosen->uid + " in " + folder.string() +
+                     " (unsupported transfer syntax or missing codec?): " + e.GetDescription());
+  }
+  double spacing_z = 0;
+  checkSlices(files, *reader, options, report, spacing_z);
+  Volume volume = fromItk<float>(reader->GetOutput());
+  volume.geometry.spacing[2] = spacing_z;  // ITK uses the first two slices only
+  return volume;
+}
+
+}  // namespace
+
+void checkDirection(const Eigen::Matrix3d& direction, const std::string& where) {
+  const double err = (direction.transpose() * direction - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!direction.allFinite() || err > 1e-3) {
+    std::ostringstream m;
+    m << "expected an orthonormal direction matrix in " << where << ", found\n" << direction;
+    throw InputError(m.str());
+  }
+}
+
+std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
+  if (!fs::is_directory(folder)) throw InputError("expected a DICOM folder, found no folder at " + folder.string());
+  if (fs::is_empty(folder)) throw InputError("expected DICOM files in " + folder.string() + ", found an empty folder");
+  std::vector<SeriesInfo> out;
+  try {
+    auto names = itk::GDCMSeriesFileNames::New();
+    names->SetUseSeriesDetails(false);
+    names->SetDirectory(folder.string());
+    for (const std::string& uid : names->GetSeriesUIDs()) {
+      SeriesInfo s;
+      s.uid = uid;
+      const auto files = names->GetFileNames(uid);
+      s.files = static_cast<int>(files.size());
+      if (!files.empty()) readHeader(files.front(), s.modality, s.description);
+      out.push_back(s);
+    }
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("could not scan " + folder.string() + " for DICOM files: " + e.GetDescription());
+  }
+  if (out.empty())
+    throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)");
+  return out;
+}
+
+Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport* report_out) {
+  ReadReport report;
+  Volume volume;
+  if (fs::is_directory(input)) {
+    volume = readDicom(input, options, report);
+  } else {
+    if (!fs::exists(input)) throw InputError("input not found: " + input.string());
+    if (!isImageFile(input))
+      throw InputError("expected a DICOM folder or a .nii/.nii.gz/.nrrd/.mha file, found " + input.string());
+    report.source = "file";
+    volume = readImageFile<float>(input);
+  }
+  checkDirection(volume.geometry.direction, input.string());
+  if (volume.geometry.size.minCoeff() < 2)
+    throw InputError("expected a 3-D volume in " + input.string() + ", found size " +
+                     std::to_string(volume.geometry.size[0]) + "x" + std::to_string(volume.geometry.size[1]) + "x" +
+                     std::to_string(volume.geometry.size[2]));
+  if (report_out) *report_out = report;
+  return volume;
+}
+
+Label readLabel(const fs::path& input) {
+  if (!fs::is_regular_file(input)) throw InputError("label image not found: " + input.string());
+  if (!isImageFile(input)) throw InputError("expected a label image (.nii.gz/.nrrd/.mha), found " + input.string());
+  const Image<float> raw = readImageFile<float>(input);
+  checkDirection(raw.geometry.direction, input.string());
+  Label label;
+  label.geometry = raw.geometry;
+  label.voxels.resize(raw.voxels.size());
+  for (size_t n = 0; n < raw.voxels.size(); ++n) label.voxels[n] = raw.voxels[n] > 0.5f ? 1 : 0;
+  return label;
+}
+
+void writeVolume(const fs::path& path, const Volume& volume, bool overwrite) {
+  Image<short> hu;
+  hu.geometry = volume.geometry;
+  hu.voxels.resize(volume.voxels.size());
+  for (size_t n = 0; n < hu.voxels.size(); ++n)
+    hu.voxels[n] = static_cast<short>(std::lround(std::clamp(volume.voxels[n], -32768.0f, 32767.0f)));
+  writeImageFile(path, hu, overwrite);
+}
+
+void writeLabel(const fs::path& path, const Label& label, bool overwrite) { writeImageFile(path, label, overwrite); }
+
+void writeDicomSeries(const fs::path& folder, const Volume& volume, const std::string& series_description) {
+  using Image3 = itk::Image<short, 3>;
+  using Image2 = itk::Image<short, 2>;
+  Image<short> hu;
+  hu.geometry = volume.geometry;
+  hu.voxels.resize(volume.voxels.size());
+  for (size_t n = 0; n < hu.voxels.size(); ++n)
+    hu.voxels[n] = static_cast<short>(std::lround(std::clamp(volume.voxels[n], -32768.0f, 32767.0f)));
+  Image3::Pointer image = toItk(hu);
+  const ImageGeometry& g = volume.geometry;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) throw InputError("cannot create folder " + folder.string() + ": " + ec.message());
+
+  gdcm::UIDGenerator uids;
+  const std::string study = uids.Generate(), series = uids.Generate(), frame = uids.Generate();
+  std::vector<itk::MetaDataDictionary> dicts(static_cast<size_t>(g.size[2]));
+  std::vector<itk::MetaDataDictionary*> dict_ptrs;
+  std::vector<std::string> files;
+  auto num = [](double v) {
+    std::ostringstream s;
+    s.precision(10);
+    s << v;
+    return s.str();
+  };
+  const Eigen::Vector3d r = g.direction.col(0), c = g.direction.col(1);
+  for (int k = 0; k < g.size[2]; ++k) {
+    itk::MetaDataDictionary& d = dicts[static_cast<size_t>(k)];
+    const Eigen::Vector3d p = g.toPhysical(Eigen::Vector3d(0, 0, k));
+    auto put = [&d](const char* tag, const std::string& v) { itk::EncapsulateMetaData<std::string>(d, tag, v); };
+    put("0008|0060", "CT");
+    put("0008|0016", "1.2.840.10008.5.1.4.1.1.2");
+    put("0008|0018", uids.Generate());
+    put("0008|103e", series_description);
+    put("0010|0010", "PHANTOM^ARTICULA");
+    put("0010|0020", "ARTICULA-PHANTOM");
+    put("0020|000d", study);
+    put("0020|000e", series);
+    put("0020|0052", frame);
+    put("0020|0011", "1");
+    put("0020|0013", std::to_string(k + 1));
+    put("0020|0032", num(p[0]) + "\\" + num(p[1]) + "\\" + num(p[2]));
+    put("0020|0037", num(r[0]) + "\\" + num(r[1]) + "\\" + num(r[2]) + "\\" + num(c[0]) + "\\" + num(c[1]) + "\\" + num(c[2]));
+    put("0018|0050", num(g.spacing[2]));
+    put("0028|0030", num(g.spacing[1]) + "\\" + num(g.spacing[0]));  // row spacing \ column spacing
+    put("0028|0004", "MONOCHROME2");
+    put("0028|1052", "0");
+    put("0028|1053", "1");
+    dict_ptrs.push_back(&d);
+    char name[32];
+    std::snprintf(name, sizeof name, "slice_%04d.dcm", k);
+    files.push_back((folder / name).string());
+  }
+  auto io = itk::GDCMImageIO::New();
+  io->KeepOriginalUIDOn();
+  auto writer = itk::ImageSeriesWriter<Image3, Image2>::New();
+  writer->SetInput(image);
+  writer->SetImageIO(io);
+  writer->SetFileNames(files);
+  writer->SetMetaDataDictionaryArray(&dict_ptrs);
+  try {
+    writer->Update();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("could not write the DICOM series to " + folder.string() + ": " + e.GetDescription());
+  }
+}
+
+}  // namespace articula::imaging

@@ -1,0 +1,108 @@
+#pragma once
+// Private to lib/imaging: copies between the plain Image<T> and itk::Image<T, 3>
+// (buffers are both i-fastest, so a straight copy), and ITK file I/O.
+// Include after articula/imaging/image.hpp (system Eigen before ITK's bundled one).
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+#include <itkImage.h>
+#include <itkImageFileReader.h>
+#include <itkImageFileWriter.h>
+
+#include "articula/core/error.hpp"
+#include "articula/imaging/image.hpp"
+
+namespace articula::imaging {
+
+template <typename T>
+typename itk::Image<T, 3>::Pointer toItk(const Image<T>& image) {
+  using ItkImage = itk::Image<T, 3>;
+  const ImageGeometry& g = image.geometry;
+  auto out = ItkImage::New();
+  typename ItkImage::RegionType region;
+  typename ItkImage::SizeType size;
+  typename ItkImage::SpacingType spacing;
+  typename ItkImage::PointType origin;
+  typename ItkImage::DirectionType direction;
+  for (unsigned a = 0; a < 3; ++a) {
+    size[a] = static_cast<itk::SizeValueType>(g.size[static_cast<int>(a)]);
+    spacing[a] = g.spacing[static_cast<int>(a)];
+    origin[a] = g.origin[static_cast<int>(a)];
+    for (unsigned b = 0; b < 3; ++b) direction(a, b) = g.direction(static_cast<int>(a), static_cast<int>(b));
+  }
+  region.SetSize(size);
+  out->SetRegions(region);
+  out->SetSpacing(spacing);
+  out->SetOrigin(origin);
+  out->SetDirection(direction);
+  out->Allocate();
+  std::copy(image.voxels.begin(), image.voxels.end(), out->GetBufferPointer());
+  return out;
+}
+
+template <typename T>
+ImageGeometry geometryOf(const itk::Image<T, 3>* image) {
+  ImageGeometry g;
+  const auto region = image->GetLargestPossibleRegion();
+  for (int a = 0; a < 3; ++a) {
+    const auto ua = static_cast<unsigned>(a);
+    g.size[a] = static_cast<int>(region.GetSize()[ua]);
+    g.spacing[a] = image->GetSpacing()[ua];
+    g.origin[a] = image->GetOrigin()[ua];
+    for (int b = 0; b < 3; ++b) g.direction(a, b) = image->GetDirection()(ua, static_cast<unsigned>(b));
+  }
+  return g;
+}
+
+/// Copies any ITK image into Image<T>; the region must start at index 0.
+template <typename T, typename U>
+Image<T> fromItk(const itk::Image<U, 3>* image) {
+  Image<T> out;
+  out.geometry = geometryOf(image);
+  const U* buffer = image->GetBufferPointer();
+  out.voxels.assign(buffer, buffer + out.geometry.voxelCount());
+  return out;
+}
+
+template <typename T>
+Image<T> readImageFile(const std::filesystem::path& path) {
+  auto reader = itk::ImageFileReader<itk::Image<T, 3>>::New();
+  reader->SetFileName(path.string());
+  try {
+    reader->Update();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("could not read the image " + path.string() + ": " + e.GetDescription());
+  }
+  return fromItk<T>(reader->GetOutput());
+}
+
+/// ITK chooses the format from the extension, so the temporary file keeps it:
+/// folder/.tmp-<pid>-<name>, renamed into place when complete.
+template <typename T>
+void writeImageFile(const std::filesystem::path& path, const Image<T>& image, bool overwrite) {
+  namespace fs = std::filesystem;
+  if (!overwrite && fs::exists(path))
+    throw UsageError("refusing to overwrite " + path.string() + " (use --force)");
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  const fs::path temp = folder / (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string());
+  auto writer = itk::ImageFileWriter<itk::Image<T, 3>>::New();
+  writer->SetInput(toItk(image));
+  writer->SetFileName(temp.string());
+  writer->UseCompressionOn();
+  try {
+    writer->Update();
+  } catch (const itk::ExceptionObject& e) {
+    fs::remove(temp, ec);
+    throw InputError("could not write " + path.string() + ": " + e.GetDescription());
+  }
+  fs::rename(temp, path, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw InputError("could not rename the finished image to " + path.string());
+  }
+}
+
+}  // namespace articula::imaging

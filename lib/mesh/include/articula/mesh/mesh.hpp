@@ -1,0 +1,52 @@
+#pragma once
+// Iso-surface of a label image with VTK (flying edges), Laplacian or
+// windowed-sinc smoothing, the largest connected surface, optional
+// decimation and normals, in the label's physical LPS millimetres; and
+// triangle-mesh file I/O (VTP, STL, PLY by extension).
+#include <filesystem>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "articula/imaging/image.hpp"
+
+namespace articula::mesh {
+
+/// #V x 3 vertices (LPS mm), #V x 3 unit outward normals (may be empty), #F x 3 triangles.
+struct TriangleMesh {
+  Eigen::MatrixX3d vertices;
+  Eigen::MatrixX3d normals;
+  Eigen::MatrixX3i triangles;
+};
+
+enum class Smoothing { Laplacian, WindowedSinc, None };
+
+struct MeshOptions {
+  Smoothing smoothing = Smoothing::Laplacian;
+  int smooth_iterations = 20;
+  double relaxation = 0.1;         // Laplacian step (vtkSmoothPolyDataFilter)
+  double passband = 0.1;           // windowed sinc pass band
+  bool largest_component = true;
+  double decimate = 0.0;           // fraction of triangles to remove, 0 = none
+  /// Throws UsageError naming the first invalid option.
+  void validate() const;
+};
+
+struct MeshSummary {
+  long long label_voxels = 0;
+  long long raw_triangles = 0;      // after flying edges
+  long long triangles = 0;          // final
+  long long vertices = 0;
+};
+
+/// Extracts the boundary of label > 0 as an oriented triangle mesh with
+/// outward normals. Throws InputError if the label has no voxel set.
+TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& options, MeshSummary* summary = nullptr);
+
+/// Writes .vtp, .stl or .ply (chosen by extension) atomically.
+void writeMesh(const std::filesystem::path& path, const TriangleMesh& mesh, bool overwrite = true);
+/// Reads .vtp, .stl, .ply, .vtk or .obj; computes normals if the file has none.
+/// Throws InputError for a missing or unreadable file or a mesh with no triangles.
+TriangleMesh readMesh(const std::filesystem::path& path);
+
+}  // namespace articula::mesh

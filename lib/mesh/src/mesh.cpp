@@ -1,0 +1,274 @@
+#include "articula/mesh/mesh.hpp"
+
+#include <unistd.h>
+
+#include <vtkCellArray.h>
+#include <vtkCleanPolyData.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkMatrix3x3.h>
+#include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkPLYReader.h>
+#include <vtkPLYWriter.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataConnectivityFilter.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkPolyDataReader.h>
+#include <vtkQuadricDecimation.h>
+#include <vtkSTLReader.h>
+#include <vtkSTLWriter.h>
+#include <vtkSmartPointer.h>
+#include <vtkSmoothPolyDataFilter.h>
+#include <vtkTriangleFilter.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkWindowedSincPolyDataFilter.h>
+#include <vtkXMLPolyDataReader.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include "articula/core/error.hpp"
+
+namespace articula::mesh {
+namespace fs = std::filesystem;
+namespace {
+
+std::string extensionOf(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+/// The label, padded by one empty voxel on every side so that the surface
+/// closes where the label touches the grid's edge, with ITK's geometry: the
+/// direction matrix puts the mesh in physical LPS (flying edges honour it).
+vtkSmartPointer<vtkImageData> toVtk(const imaging::Label& label) {
+  const imaging::ImageGeometry& g = label.geometry;
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(g.size[0] + 2, g.size[1] + 2, g.size[2] + 2);
+  image->SetSpacing(g.spacing[0], g.spacing[1], g.spacing[2]);
+  const Eigen::Vector3d origin = g.toPhysical(Eigen::Vector3d::Constant(-1.0));
+  image->SetOrigin(origin[0], origin[1], origin[2]);
+  double direction[9];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) direction[3 * r + c] = g.direction(r, c);  // row-major
+  image->SetDirectionMatrix(direction);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  auto* buffer = static_cast<unsigned char*>(image->GetScalarPointer());
+  std::fill(buffer, buffer + static_cast<long long>(g.size[0] + 2) * (g.size[1] + 2) * (g.size[2] + 2), 0);
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        buffer[(i + 1) + static_cast<long long>(g.size[0] + 2) * ((j + 1) + static_cast<long long>(g.size[1] + 2) * (k + 1))] =
+            label.at(i, j, k) ? 1 : 0;
+  return image;
+}
+
+vtkSmartPointer<vtkPolyData> withNormals(vtkPolyData* input) {
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(input);
+  normals->ComputePointNormalsOn();
+  normals->ComputeCellNormalsOff();
+  normals->SplittingOff();
+  normals->ConsistencyOn();
+  normals->AutoOrientNormalsOn();  // outward on closed surfaces
+  normals->Update();
+  return normals->GetOutput();
+}
+
+TriangleMesh fromVtk(vtkPolyData* poly) {
+  TriangleMesh mesh;
+  const vtkIdType n = poly->GetNumberOfPoints();
+  mesh.vertices.resize(n, 3);
+  for (vtkIdType v = 0; v < n; ++v) {
+    double p[3];
+    poly->GetPoint(v, p);
+    mesh.vertices.row(v) << p[0], p[1], p[2];
+  }
+  if (vtkDataArray* normals = poly->GetPointData()->GetNormals()) {
+    mesh.normals.resize(n, 3);
+    for (vtkIdType v = 0; v < n; ++v) {
+      double q[3];
+      normals->GetTuple(v, q);
+      mesh.normals.row(v) = Eigen::RowVector3d(q[0], q[1], q[2]).normalized();
+    }
+  }
+  std::vector<Eigen::Vector3i> triangles;
+  vtkCellArray* polys = poly->GetPolys();
+  polys->InitTraversal();
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  while (polys->GetNextCell(count, ids))
+    if (count == 3)
+      triangles.emplace_back(static_cast<int>(ids[0]), static_cast<int>(ids[1]), static_cast<int>(ids[2]));
+  mesh.triangles.resize(static_cast<Eigen::Index>(triangles.size()), 3);
+  for (size_t t = 0; t < triangles.size(); ++t) mesh.triangles.row(static_cast<Eigen::Index>(t)) = triangles[t].transpose();
+  return mesh;
+}
+
+vtkSmartPointer<vtkPolyData> toVtk(const TriangleMesh& mesh) {
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+    points->InsertNextPoint(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
+  poly->SetPoints(points);
+  vtkNew<vtkCellArray> cells;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    const vtkIdType ids[3] = {mesh.triangles(t, 0), mesh.triangles(t, 1), mesh.triangles(t, 2)};
+    cells->InsertNextCell(3, ids);
+  }
+  poly->SetPolys(cells);
+  if (mesh.normals.rows() == mesh.vertices.rows()) {
+    vtkNew<vtkFloatArray> normals;
+    normals->SetNumberOfComponents(3);
+    normals->SetName("Normals");
+    for (Eigen::Index v = 0; v < mesh.normals.rows(); ++v)
+      normals->InsertNextTuple3(mesh.normals(v, 0), mesh.normals(v, 1), mesh.normals(v, 2));
+    poly->GetPointData()->SetNormals(normals);
+  }
+  return poly;
+}
+
+}  // namespace
+
+void MeshOptions::validate() const {
+  if (smooth_iterations < 0 || smooth_iterations > 10000) throw UsageError("--smooth-iterations: expected 0 to 10000");
+  if (!(relaxation > 0 && relaxation <= 1)) throw UsageError("--relaxation: expected a value in (0, 1]");
+  if (!(passband > 0 && passband <= 2)) throw UsageError("--passband: expected a value in (0, 2]");
+  if (!(decimate >= 0 && decimate < 1)) throw UsageError("--decimate: expected a fraction in [0, 1)");
+}
+
+TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& options, MeshSummary* summary) {
+  options.validate();
+  long long voxels = 0;
+  for (auto v : label.voxels) voxels += v ? 1 : 0;
+  if (voxels == 0) throw InputError("the label has no voxel set: nothing to mesh");
+
+  vtkNew<vtkFlyingEdges3D> iso;
+  iso->SetInputData(toVtk(label));
+  iso->SetValue(0, 0.5);
+  iso->ComputeNormalsOff();
+  iso->ComputeGradientsOff();
+  iso->ComputeScalarsOff();
+  iso->Update();
+  vtkSmartPointer<vtkPolyData> poly = iso->GetOutput();
+  const long long raw = poly->GetNumberOfPolys();
+
+  if (options.largest_component) {
+    vtkNew<vtkPolyDataConnectivityFilter> largest;
+    largest->SetInputData(poly);
+    largest->SetExtractionModeToLargestRegion();
+    vtkNew<vtkCleanPolyData> clean;  // drops the points of the other regions
+    clean->SetInputConnection(largest->GetOutputPort());
+    clean->Update();
+    poly = clean->GetOutput();
+  }
+  if (options.smoothing == Smoothing::Laplacian && options.smooth_iterations > 0) {
+    vtkNew<vtkSmoothPolyDataFilter> smooth;
+    smooth->SetInputData(poly);
+    smooth->SetNumberOfIterations(options.smooth_iterations);
+    smooth->SetRelaxationFactor(options.relaxation);
+    smooth->FeatureEdgeSmoothingOff();
+    smooth->BoundarySmoothingOn();
+    smooth->Update();
+    poly = smooth->GetOutput();
+  } else if (options.smoothing == Smoothing::WindowedSinc && options.smooth_iterations > 0) {
+    vtkNew<vtkWindowedSincPolyDataFilter> smooth;
+    smooth->SetInputData(poly);
+    smooth->SetNumberOfIterations(options.smooth_iterations);
+    smooth->SetPassBand(options.passband);
+    smooth->NormalizeCoordinatesOn();
+    smooth->FeatureEdgeSmoothingOff();
+    smooth->BoundarySmoothingOn();
+    smooth->NonManifoldSmoothingOn();
+    smooth->Update();
+    poly = smooth->GetOutput();
+  }
+  if (options.decimate > 0) {
+    vtkNew<vtkQuadricDecimation> decimate;
+    decimate->SetInputData(poly);
+    decimate->SetTargetReduction(options.decimate);
+    decimate->Update();
+    poly = decimate->GetOutput();
+  }
+  TriangleMesh mesh = fromVtk(withNormals(poly));
+  if (mesh.triangles.rows() == 0) throw ProcessingError("the iso-surface has no triangles");
+  if (summary) {
+    summary->label_voxels = voxels;
+    summary->raw_triangles = raw;
+    summary->triangles = mesh.triangles.rows();
+    summary->vertices = mesh.vertices.rows();
+  }
+  return mesh;
+}
+
+void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
+  if (!overwrite && fs::exists(path)) throw UsageError("refusing to overwrite " + path.string() + " (use --force)");
+  const std::string ext = extensionOf(path);
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  const fs::path temp = folder / (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string());
+  const vtkSmartPointer<vtkPolyData> poly = toVtk(mesh);
+  int ok = 0;
+  if (ext == ".vtp") {
+    vtkNew<vtkXMLPolyDataWriter> w;
+    w->SetInputData(poly);
+    w->SetFileName(temp.c_str());
+    w->SetDataModeToBinary();
+    ok = w->Write();
+  } else if (ext == ".stl") {
+    vtkNew<vtkSTLWriter> w;
+    w->SetInputData(poly);
+    w->SetFileName(temp.c_str());
+    w->SetFileTypeToBinary();
+    w->SetHeader("articula mesh; coordinates LPS, units mm");
+    ok = w->Write();
+  } else if (ext == ".ply") {
+    vtkNew<vtkPLYWriter> w;
+    w->SetInputData(poly);
+    w->SetFileName(temp.c_str());
+    w->SetFileTypeToBinary();
+    w->AddComment("articula mesh; coordinates LPS, units mm");
+    ok = w->Write();
+  } else {
+    throw UsageError("expected a mesh file ending in .vtp, .stl or .ply, found '" + path.string() + "'");
+  }
+  if (!ok || !fs::exists(temp)) {
+    fs::remove(temp, ec);
+    throw InputError("could not write " + path.string());
+  }
+  fs::rename(temp, path, ec);
+  if (ec) throw InputError("could not rename the finished mesh to " + path.string());
+}
+
+TriangleMesh readMesh(const fs::path& path) {
+  if (!fs::is_regular_file(path)) throw InputError("mesh not found: " + path.string());
+  const std::string ext = extensionOf(path);
+  vtkSmartPointer<vtkPolyData> poly;
+  auto read = [&](auto reader) {
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    poly = reader->GetOutput();
+  };
+  if (ext == ".vtp") read(vtkSmartPointer<vtkXMLPolyDataReader>::New());
+  else if (ext == ".stl") read(vtkSmartPointer<vtkSTLReader>::New());
+  else if (ext == ".ply") read(vtkSmartPointer<vtkPLYReader>::New());
+  else if (ext == ".vtk") read(vtkSmartPointer<vtkPolyDataReader>::New());
+  else if (ext == ".obj") read(vtkSmartPointer<vtkOBJReader>::New());
+  else throw InputError("expected a mesh (.vtp, .stl, .ply, .vtk, .obj), found " + path.string());
+  if (!poly || poly->GetNumberOfPolys() == 0)
+    throw InputError("expected a triangle mesh in " + path.string() + ", found no triangles" +
+                     (poly ? " (" + std::to_string(poly->GetNumberOfPoints()) + " points)" : ""));
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputData(poly);
+  triangles->Update();
+  poly = triangles->GetOutput();
+  if (!poly->GetPointData()->GetNormals()) poly = withNormals(poly);
+  return fromVtk(poly);
+}
+
+}  // namespace articula::mesh

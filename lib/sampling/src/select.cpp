@@ -1,0 +1,188 @@
+#include "articula/sampling/select.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Random.h>
+#include <CGAL/Shape_detection/Efficient_RANSAC.h>
+#include <CGAL/property_map.h>
+
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+
+namespace articula::sampling {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using PointWithNormal = std::pair<Kernel::Point_3, Kernel::Vector_3>;
+using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, std::vector<PointWithNormal>,
+                                                              CGAL::First_of_pair_property_map<PointWithNormal>,
+                                                              CGAL::Second_of_pair_property_map<PointWithNormal>>;
+using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
+using RansacSphere = CGAL::Shape_detection::Sphere<Traits>;
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[static_cast<size_t>(i)] != i) i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+  return i;
+}
+
+/// The largest connected patch of `chosen` vertices, connected through triangle edges.
+std::vector<int> largestPatch(const std::vector<char>& chosen, const Eigen::MatrixX3i& F) {
+  std::vector<int> parent(chosen.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const int a = F(t, e), b = F(t, (e + 1) % 3);
+      if (chosen[static_cast<size_t>(a)] && chosen[static_cast<size_t>(b)]) parent[static_cast<size_t>(findRoot(parent, a))] = findRoot(parent, b);
+    }
+  std::vector<int> size(chosen.size(), 0);
+  for (size_t v = 0; v < chosen.size(); ++v)
+    if (chosen[v]) ++size[static_cast<size_t>(findRoot(parent, static_cast<int>(v)))];
+  const int best = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  std::vector<int> out;
+  for (size_t v = 0; v < chosen.size(); ++v)
+    if (chosen[v] && findRoot(parent, static_cast<int>(v)) == best) out.push_back(static_cast<int>(v));
+  return out;
+}
+
+std::vector<double> parseNumbers(const std::string& text, const std::string& what) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--select " + what + ": expected numbers, found '" + item + "'");
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void SelectOptions::validate() const {
+  if (mode == Mode::Sphere && !(radius > 0)) throw UsageError("--select sphere: the radius must be > 0");
+  if (mode == Mode::Box && (box_max.array() <= box_min.array()).any())
+    throw UsageError("--select box: expected XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX with min < max");
+  if (!(min_radius_mm > 0 && min_radius_mm < max_radius_mm)) throw UsageError("sphere radius range must satisfy 0 < min < max");
+  if (!(band_mm > 0)) throw UsageError("selection band must be > 0 mm");
+  if (!(normal_deg > 0 && normal_deg <= 90)) throw UsageError("normal tolerance must be in (0, 90] degrees");
+  if (min_points < 1) throw UsageError("minimum selected points must be >= 1");
+}
+
+void parseSelection(const std::string& text, SelectOptions& o) {
+  if (text == "auto") {
+    o.mode = SelectOptions::Mode::Auto;
+  } else if (text.rfind("sphere:", 0) == 0) {
+    const auto v = parseNumbers(text.substr(7), "sphere");
+    if (v.size() != 4) throw UsageError("--select sphere:X,Y,Z,R: expected 4 numbers, found " + std::to_string(v.size()));
+    o.mode = SelectOptions::Mode::Sphere;
+    o.center = Eigen::Vector3d(v[0], v[1], v[2]);
+    o.radius = v[3];
+  } else if (text.rfind("box:", 0) == 0) {
+    const auto v = parseNumbers(text.substr(4), "box");
+    if (v.size() != 6) throw UsageError("--select box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: expected 6 numbers, found " + std::to_string(v.size()));
+    o.mode = SelectOptions::Mode::Box;
+    o.box_min = Eigen::Vector3d(v[0], v[1], v[2]);
+    o.box_max = Eigen::Vector3d(v[3], v[4], v[5]);
+  } else {
+    throw UsageError("--select: expected auto, sphere:X,Y,Z,R or box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, found '" + text + "'");
+  }
+  o.validate();
+}
+
+void fitSphere(const Eigen::MatrixX3d& P, Eigen::Vector3d& center, double& radius) {
+  // |x|^2 = 2 c.x + (r^2 - |c|^2): linear in (c, d).
+  Eigen::MatrixXd A(P.rows(), 4);
+  A.leftCols<3>() = 2.0 * P;
+  A.col(3).setOnes();
+  const Eigen::VectorXd b = P.rowwise().squaredNorm();
+  const Eigen::Vector4d s = A.colPivHouseholderQr().solve(b);
+  center = s.head<3>();
+  radius = std::sqrt(std::max(0.0, s[3] + center.squaredNorm()));
+}
+
+Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
+                          const SelectOptions& o) {
+  o.validate();
+  Selection sel;
+  const Eigen::Index n = V.rows();
+  if (o.mode == SelectOptions::Mode::Sphere || o.mode == SelectOptions::Mode::Box) {
+    for (Eigen::Index v = 0; v < n; ++v) {
+      const Eigen::Vector3d x = V.row(v).transpose();
+      const bool in = o.mode == SelectOptions::Mode::Sphere
+                          ? (x - o.center).norm() <= o.radius
+                          : (x.array() >= o.box_min.array()).all() && (x.array() <= o.box_max.array()).all();
+      if (in) sel.indices.push_back(static_cast<int>(v));
+    }
+  } else {
+    if (N.rows() != n) throw InputError("--select auto needs vertex normals; the mesh has none");
+    std::vector<PointWithNormal> points;
+    points.reserve(static_cast<size_t>(n));
+    for (Eigen::Index v = 0; v < n; ++v)
+      points.emplace_back(Kernel::Point_3(V(v, 0), V(v, 1), V(v, 2)), Kernel::Vector_3(N(v, 0), N(v, 1), N(v, 2)));
+    CGAL::get_default_random() = CGAL::Random(static_cast<unsigned>(o.seed));  // reproducible sampling
+    Ransac ransac;
+    ransac.set_input(points);
+    ransac.add_shape_factory<RansacSphere>();
+    Ransac::Parameters parameters;
+    parameters.probability = 0.01;
+    parameters.min_points = static_cast<std::size_t>(std::max<Eigen::Index>(50, n / 50));
+    parameters.epsilon = o.band_mm;
+    parameters.cluster_epsilon = 3.0 * o.band_mm;
+    parameters.normal_threshold = std::cos(o.normal_deg * M_PI / 180.0);
+    ransac.detect(parameters);
+    size_t best_count = 0;
+    for (const auto& shape : ransac.shapes()) {
+      const auto* sphere = dynamic_cast<const RansacSphere*>(shape.get());
+      if (!sphere) continue;
+      const double r = sphere->radius();
+      if (r < o.min_radius_mm || r > o.max_radius_mm) continue;
+      ++sel.ransac_spheres;
+      if (shape->indices_of_assigned_points().size() > best_count) {
+        best_count = shape->indices_of_assigned_points().size();
+        const auto c = sphere->center();
+        sel.sphere_center = Eigen::Vector3d(c.x(), c.y(), c.z());
+        sel.sphere_radius = r;
+      }
+    }
+    if (sel.ransac_spheres == 0) {
+      std::ostringstream m;
+      m << "no joint head found: RANSAC found no sphere of radius " << o.min_radius_mm << "-" << o.max_radius_mm
+        << " mm on the mesh (" << n << " vertices); select the region by hand with --select sphere:X,Y,Z,R";
+      throw ProcessingError(m.str());
+    }
+    // Band around the sphere, normals radial, largest connected patch; then
+    // once more around the least-squares sphere of that patch.
+    const double cos_tol = std::cos(o.normal_deg * M_PI / 180.0);
+    for (int pass = 0; pass < 2; ++pass) {
+      std::vector<char> chosen(static_cast<size_t>(n), 0);
+      for (Eigen::Index v = 0; v < n; ++v) {
+        const Eigen::Vector3d d = V.row(v).transpose() - sel.sphere_center;
+        const double r = d.norm();
+        chosen[static_cast<size_t>(v)] = std::fabs(r - sel.sphere_radius) <= o.band_mm &&
+                                          N.row(v).dot(d.transpose()) >= cos_tol * r;
+      }
+      sel.indices = largestPatch(chosen, F);
+      if (static_cast<int>(sel.indices.size()) < std::max(o.min_points, 4)) break;
+      Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3);
+      for (size_t i = 0; i < sel.indices.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(sel.indices[i]);
+      fitSphere(P, sel.sphere_center, sel.sphere_radius);
+      sel.sphere_rms_mm = std::sqrt(((P.rowwise() - sel.sphere_center.transpose()).rowwise().norm().array() - sel.sphere_radius).square().mean());
+    }
+  }
+  if (static_cast<int>(sel.indices.size()) < o.min_points)
+    throw InputError("the selection holds " + std::to_string(sel.indices.size()) + " points; expected at least " +
+                     std::to_string(o.min_points) + " to fit a surface");
+  return sel;
+}
+
+}  // namespace articula::sampling

@@ -1,0 +1,197 @@
+// Imaging: file round trips (NIfTI, DICOM) keep the physical geometry, the
+// bad-input checks refuse with exit code 3, and the head segmentation of the
+// phantom matches its truth; the real CTs give one plausible head.
+#include <fstream>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "articula/core/error.hpp"
+#include "articula/imaging/io.hpp"
+#include "articula/imaging/segment.hpp"
+#include "ct_test_support.hpp"
+
+namespace articula {
+namespace {
+
+using imaging::ImageGeometry;
+using testing::headDistance;
+
+phantom::Phantom smallPhantom(unsigned long long seed, bool ras = false) {
+  phantom::PhantomOptions o;
+  o.seed = seed;
+  o.spacing = Eigen::Vector3d(1.2, 1.2, 2.0);
+  o.ras_storage = ras;
+  return phantom::makePhantom(o);
+}
+
+void expectSameGeometry(const ImageGeometry& a, const ImageGeometry& b) {
+  EXPECT_EQ(a.size, b.size);
+  EXPECT_LT((a.spacing - b.spacing).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_LT((a.origin - b.origin).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_LT((a.direction - b.direction).cwiseAbs().maxCoeff(), 1e-6);
+  // The same voxel lands on the same physical point.
+  const Eigen::Vector3d ijk(3, 7, 5);
+  EXPECT_LT((a.toPhysical(ijk) - b.toPhysical(ijk)).norm(), 1e-3);
+}
+
+TEST(ImagingIo, NiftiRoundTripKeepsLpsGeometryEvenWhenStoredRas) {
+  for (bool ras : {false, true}) {
+    const phantom::Phantom p = smallPhantom(2, ras);
+    const auto dir = testing::scratch("nifti");
+    imaging::writeVolume(dir / "ct.nii.gz", p.ct);
+    imaging::ReadReport report;
+    const imaging::Volume back = imaging::readVolume(dir / "ct.nii.gz", {}, &report);
+    expectSameGeometry(p.ct.geometry, back.geometry);
+    double worst = 0;
+    for (size_t n = 0; n < back.voxels.size(); ++n) worst = std::max(worst, std::fabs(double(back.voxels[n]) - p.ct.voxels[n]));
+    EXPECT_LE(worst, 0.5 + 1e-6);  // stored as int16
+    std::filesystem::remove_all(dir);
+  }
+}
+
+TEST(ImagingIo, DicomSeriesRoundTripAndChecks) {
+  const phantom::Phantom p = smallPhantom(3, true);
+  const auto dir = testing::scratch("dicom");
+  imaging::writeDicomSeries(dir / "series", p.ct, "test");
+  imaging::ReadReport report;
+  const imaging::Volume back = imaging::readVolume(dir / "series", {}, &report);
+  expectSameGeometry(p.ct.geometry, back.geometry);
+  EXPECT_EQ(report.source, "dicom");
+  EXPECT_EQ(report.modality, "CT");
+  EXPECT_NEAR(report.slice_spacing_mm, 2.0, 1e-6);
+  EXPECT_LT(report.gantry_tilt_deg, 1e-3);
+  EXPECT_NEAR(back.at(10, 20, 5), std::lround(p.ct.at(10, 20, 5)), 1e-3);
+
+  // A missing slice in the middle: refused with the gap named.
+  std::filesystem::remove(dir / "series" / "slice_0010.dcm");
+  try {
+    imaging::readVolume(dir / "series", {});
+    ADD_FAILURE() << "a missing slice was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("non-uniform slice spacing"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("slice_0009.dcm"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ImagingIo, BadFoldersAndFilesAreInputErrors) {
+  const auto dir = testing::scratch("bad");
+  EXPECT_THROW(imaging::readVolume(dir, {}), InputError);  // empty folder
+  std::ofstream(dir / "notes.txt") << "not a DICOM file\n";
+  EXPECT_THROW(imaging::readVolume(dir, {}), InputError);  // no DICOM inside
+  EXPECT_THROW(imaging::readVolume(dir / "missing.nii.gz", {}), InputError);
+  EXPECT_THROW(imaging::readVolume(dir / "notes.txt", {}), InputError);
+  std::ofstream(dir / "broken.nii.gz") << "garbage";
+  EXPECT_THROW(imaging::readVolume(dir / "broken.nii.gz", {}), InputError);
+  EXPECT_THROW(imaging::checkDirection(Eigen::Matrix3d::Constant(1.0), "test"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+struct HeadCheck {
+  double head_recall;     // fraction of voxels 1 voxel inside the true head (off the neck) labelled
+  double socket_leak;     // fraction of labelled voxels farther than gap/2 outside the head
+  double center_error_mm; // deepest label point vs true centre
+};
+
+HeadCheck checkHead(const phantom::Phantom& p, const imaging::Label& label, const imaging::SegmentSummary& s) {
+  const auto head = geometry::makeSurface(p.head);
+  const ImageGeometry& g = p.ct.geometry;
+  const double voxel = g.spacing.maxCoeff();
+  long long inside = 0, inside_hit = 0, labelled = 0, leak = 0;
+  const double gap = p.truth["joint_gap_mm"].get<double>();
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const Eigen::Vector3d x = g.toPhysical(Eigen::Vector3d(i, j, k));
+        if ((x - p.head.center).norm() > 45) continue;
+        const double d = headDistance(*head, x);
+        const bool l = label.at(i, j, k) != 0;
+        // Recall over the articular part: away from the neck, where the cut lies.
+        if (d < -voxel && (x - p.head.center).normalized().dot(p.neck_axis) < 0.3) inside++, inside_hit += l;
+        if (l) {
+          labelled++;
+          // Outside the head and not in the femur (neck): the socket side.
+          if (d > gap / 2 && !p.femur.at(i, j, k)) leak++;
+        }
+      }
+  return {double(inside_hit) / std::max<long long>(inside, 1), double(leak) / std::max<long long>(labelled, 1),
+          (s.head_center_mm - p.head.center).norm()};
+}
+
+TEST(ImagingSegment, PhantomHeadMatchesTruthAcrossGapsSidesAndSpacings) {
+  struct Case { double gap; bool right; Eigen::Vector3d spacing; };
+  for (const Case& c : {Case{2.0, true, {0.7, 0.7, 1.5}}, Case{4.0, false, {0.7, 0.7, 1.5}},
+                       Case{3.0, true, {1.0, 1.0, 2.0}}}) {
+    phantom::PhantomOptions o;
+    o.seed = 7;
+    o.model = geometry::ShapeModel::Ellipsoid;
+    o.gap_mm = c.gap;
+    o.right = c.right;
+    o.spacing = c.spacing;
+    const phantom::Phantom p = phantom::makePhantom(o);
+    imaging::SegmentOptions so;
+    so.side = c.right ? imaging::Side::Right : imaging::Side::Left;
+    imaging::SegmentSummary s;
+    const imaging::Label label = imaging::segmentHead(p.ct, so, &s);
+    const HeadCheck h = checkHead(p, label, s);
+    SCOPED_TRACE("gap " + std::to_string(c.gap) + (c.right ? " right" : " left"));
+    EXPECT_GT(h.head_recall, 0.97);
+    EXPECT_LT(h.socket_leak, 0.01);
+    // The deepest label point is not the centre of an ellipsoid on a neck, but deep inside it.
+    EXPECT_LT(h.center_error_mm, 5.0);
+    EXPECT_LT(headDistance(*geometry::makeSurface(p.head), s.head_center_mm), -0.7 * p.head.radii.minCoeff());
+    EXPECT_GT(s.head_depth_mm, 0.8 * p.head.radii.minCoeff());
+  }
+}
+
+TEST(ImagingSegment, SeedPointAndFailures) {
+  const phantom::Phantom p = smallPhantom(4);
+  imaging::SegmentOptions so;
+  so.seed_point = p.head.center;
+  imaging::SegmentSummary s;
+  const imaging::Label label = imaging::segmentHead(p.ct, so, &s);
+  EXPECT_EQ(s.seed_source, "seed-point");
+  EXPECT_GT(checkHead(p, label, s).head_recall, 0.95);
+  // A window no voxel falls in: invalid input (exit 3).
+  so.hu_min = 5000;
+  so.hu_max = 6000;
+  EXPECT_THROW(imaging::segmentHead(p.ct, so), InputError);
+  // The wrong side holds no head: processing failed (exit 1).
+  imaging::SegmentOptions left;
+  left.side = imaging::Side::Left;
+  left.min_head_radius_mm = 30;
+  EXPECT_THROW(imaging::segmentHead(p.ct, left), ProcessingError);
+}
+
+TEST(ImagingRealData, HipAndShoulderHeadsHavePlausibleDepth) {
+  const auto hip = testing::sharedData() / "ct/hip-3mm-nifti/example_ct.nii.gz";
+  const auto thorax = testing::sharedData() / "ct/thorax-shoulders-dicom";
+  if (!std::filesystem::exists(hip) || !std::filesystem::exists(thorax)) GTEST_SKIP() << "no shared CT data";
+  {
+    const imaging::Volume ct = imaging::readVolume(hip, {});
+    EXPECT_LT((ct.geometry.direction - Eigen::Vector3d(-1, -1, 1).asDiagonal().toDenseMatrix()).norm(), 1e-6);
+    imaging::SegmentOptions so;  // right hip
+    imaging::SegmentSummary s;
+    imaging::segmentHead(ct, so, &s);
+    // Deepest point of the head: a little under its radius (20-28 mm).
+    EXPECT_GT(s.head_depth_mm, 14.0);
+    EXPECT_LT(s.head_depth_mm, 30.0);
+    EXPECT_LT(s.head_center_mm[0], 0.0);  // patient right is -x in LPS
+  }
+  {
+    imaging::ReadReport report;
+    const imaging::Volume ct = imaging::readVolume(thorax, {}, &report);
+    EXPECT_EQ(ct.geometry.size, Eigen::Vector3i(512, 512, 141));
+    EXPECT_NEAR(report.slice_spacing_mm, 2.0, 0.01);
+    imaging::SegmentOptions so;
+    so.joint = imaging::Joint::Shoulder;
+    imaging::SegmentSummary s;
+    imaging::segmentHead(ct, so, &s);
+    EXPECT_GT(s.head_depth_mm, 14.0);
+    EXPECT_LT(s.head_depth_mm, 30.0);
+  }
+}
+
+}  // namespace
+}  // namespace articula
