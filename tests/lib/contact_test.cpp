@@ -419,7 +419,9 @@ TEST(Proximity, BoundingSpheresAndExactSeparation) {
     ConvexShape a = randomShape(rng, 0.5, 1.5), b = randomShape(rng, 0.5, 1.5);
     placeAt(a, b, rng, gap(rng));
     const double d = referenceDistance(a, b);
-    if (d <= 0.0) EXPECT_TRUE(boundingSpheresOverlap(a, b));
+    if (d <= 0.0) {
+      EXPECT_TRUE(boundingSpheresOverlap(a, b));
+    }
     if (std::fabs(d) < 1e-6) continue;
     ++checked;
     EXPECT_EQ(ellipsoidRelation(a, b), d > 0 ? EllipsoidRelation::Separated : EllipsoidRelation::Overlapping)

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <vector>
 
-#include <Eigen/LU>
+#include <Eigen/Cholesky>
 
 #include "articula/contact/frame_derivatives.hpp"
 #include "articula/core/error.hpp"
@@ -124,6 +124,38 @@ const std::vector<Vector3d>& sphereDirections(int count) {
   return cache;
 }
 
+// Solves J x = rhs by Gaussian elimination with partial pivoting; false when a
+// pivot falls below 1e-14 of the largest entry (singular to working precision).
+// Hand-written: Eigen's PartialPivLU takes its blocked dynamic-size path even
+// for a fixed 6x6, and with rcond() it was most of the solver's time (perf).
+bool solve6(Matrix6d J, Vector6d rhs, Vector6d& x) {
+  const double scale = J.cwiseAbs().maxCoeff();
+  if (!(scale > 0.0) || !std::isfinite(scale)) return false;
+  for (int k = 0; k < 6; ++k) {
+    int p = k;
+    for (int i = k + 1; i < 6; ++i)
+      if (std::fabs(J(i, k)) > std::fabs(J(p, k))) p = i;
+    if (!(std::fabs(J(p, k)) > 1e-14 * scale)) return false;
+    if (p != k) {
+      J.row(p).swap(J.row(k));
+      std::swap(rhs[p], rhs[k]);
+    }
+    const double inv = 1.0 / J(k, k);
+    for (int i = k + 1; i < 6; ++i) {
+      const double f = J(i, k) * inv;
+      if (f == 0.0) continue;
+      for (int j = k + 1; j < 6; ++j) J(i, j) -= f * J(k, j);
+      rhs[i] -= f * rhs[k];
+    }
+  }
+  for (int k = 5; k >= 0; --k) {
+    double sum = rhs[k];
+    for (int j = k + 1; j < 6; ++j) sum -= J(k, j) * x[j];
+    x[k] = sum / J(k, k);
+  }
+  return x.allFinite();
+}
+
 struct Solver {
   const ConvexShape& a;
   const ConvexShape& b;
@@ -153,10 +185,8 @@ struct Solver {
         break;
       }
       ++summary.iterations;
-      const Eigen::PartialPivLU<Matrix6d> lu(J);
-      delta = -lu.solve(phi);
       bool accepted = false;
-      if (delta.allFinite() && lu.rcond() > 1e-14) {
+      if (solve6(J, -phi, delta)) {
         const double norm = delta.norm();
         if (norm > 0.5) delta *= 0.5 / norm;  // a point never needs to move more than this at once
         for (double alpha = 1.0; alpha >= 1.0 / 64.0; alpha *= 0.5) {

@@ -34,7 +34,7 @@ struct ContactOptions {
   geometry::FrameMethod frame = geometry::FrameMethod::Householder;  // or SquarePlate
   int max_iterations = 40;          // Newton iterations per start
   double step_tolerance = 1e-13;    // stop when |delta u| (canonical, dimensionless) is below
-  double residual_tolerance = 1e-15;  // or when |Phi| (dimensionless) is below
+  double residual_tolerance = 1e-14;  // or when |Phi| (dimensionless) is below
   int sample_directions = 64;       // dual samples for the global search (overlap)
   int global_starts = 3;            // Newton starts from the best distinct samples
   bool verify_warm_overlap = false;  // warm start and overlap: also run the global search
