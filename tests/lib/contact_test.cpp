@@ -12,6 +12,7 @@
 #include "articula/contact/frame_derivatives.hpp"
 #include "articula/contact/plane_contact.hpp"
 #include "articula/contact/proximity.hpp"
+#include "articula/contact/reference.hpp"
 #include "articula/contact/scenario.hpp"
 #include "articula/core/error.hpp"
 #include "articula/geometry/surfaces.hpp"
@@ -34,48 +35,7 @@ ConvexShape randomShape(std::mt19937_64& rng, double r_min, double r_max, double
   return makeConvexShape(Vector3d::Zero(), randomRotation(rng), Vector3d(r(rng), r(rng), r(rng)), exps);
 }
 
-// ---- long-double reference for ellipsoid pairs (independent of the solver)
-using Vec3L = Eigen::Matrix<long double, 3, 1>;
-using Mat3L = Eigen::Matrix<long double, 3, 3>;
-Mat3L shapeMatrix(const ConvexShape& s) {
-  const Mat3L R = s.rotation.cast<long double>();
-  const Vec3L r2 = s.radii.cast<long double>().cwiseAbs2();
-  return R * r2.asDiagonal() * R.transpose();
-}
-long double dualL(const Mat3L& Ma, const Mat3L& Mb, const Vec3L& c, const Vec3L& v) {
-  return v.dot(c) - std::sqrt(v.dot(Ma * v)) - std::sqrt(v.dot(Mb * v));
-}
-double referenceDistance(const ConvexShape& a, const ConvexShape& b) {
-  const Mat3L Ma = shapeMatrix(a), Mb = shapeMatrix(b);
-  const Vec3L c = (b.center - a.center).cast<long double>();
-  const int n = 4000;
-  std::vector<std::pair<long double, Vec3L>> samples;
-  for (int i = 0; i < n; ++i) {
-    const long double z = 1.0L - (2.0L * i + 1.0L) / n, r = std::sqrt(1.0L - z * z), t = 2.399963229728653L * i;
-    const Vec3L v(r * std::cos(t), r * std::sin(t), z);
-    samples.push_back({dualL(Ma, Mb, c, v), v});
-  }
-  std::sort(samples.begin(), samples.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
-  long double best = -1e300L;
-  for (int k = 0; k < 6; ++k) {  // local ascent from the best few samples
-    Vec3L v = samples[static_cast<size_t>(k)].second;
-    long double s = samples[static_cast<size_t>(k)].first, step = 0.05L;
-    for (int it = 0; it < 20000 && step > 1e-17L; ++it) {
-      const Vec3L g = c - Ma * v / std::sqrt(v.dot(Ma * v)) - Mb * v / std::sqrt(v.dot(Mb * v));
-      const Vec3L gt = g - g.dot(v) * v;
-      if (gt.norm() < 1e-19L) break;
-      const Vec3L trial = (v + step * gt / gt.norm()).normalized();
-      const long double ts = dualL(Ma, Mb, c, trial);
-      if (ts > s) {
-        s = ts, v = trial, step *= 1.5L;
-      } else {
-        step *= 0.5L;
-      }
-    }
-    best = std::max(best, s);
-  }
-  return static_cast<double>(best);
-}
+double referenceDistance(const ConvexShape& a, const ConvexShape& b) { return referenceEllipsoidDistance(a, b); }
 
 // ---------------------------------------------------------------- shape pieces
 
