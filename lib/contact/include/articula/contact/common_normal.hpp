@@ -1,0 +1,92 @@
+#pragma once
+// Minimum signed distance between two smooth convex bodies (sphere, ellipsoid,
+// superellipsoid) by the common-normal system of thesis eq. 5.23, solved by
+// Newton-Raphson (eq. 5.22) with the analytic 6x6 Jacobian (eq. 5.26-5.28).
+//
+// Unknowns: the canonical coordinates u_A, u_B of the two points (q^G of
+// eq. 5.24 up to the diagonal scaling D). Residual (rows 3-4 divided by a
+// length L so that every row is dimensionless):
+//   [ n_A . t_B, n_A . b_B, d . t_B / L, d . b_B / L, F_A(u_A), F_B(u_B) ],
+// with n_A the unit outward normal of A, (t_B, b_B) the tangent frame of B's
+// unit normal (Householder or square plate) and d = x_B - x_A.
+//
+// Finding the right solution every time: the support-function dual
+//   s(v) = v . (c_B - c_A) - h_A(v) - h_B(-v),   signed distance = max_|v|=1 s(v)
+// has, at a common-normal pair with opposite normals, s(n_A) = n_A . d and a
+// stationary point. s is concave and 1-homogeneous, so a stationary point with
+// s > 0 is the global maximum: a separated answer is certified. Otherwise
+// (overlap) the dual is sampled over the sphere and Newton is started from
+// the best distinct directions; the answer is the largest s found (the
+// minimum penetration depth). Newton is damped by a backtracking line search;
+// on a singular Jacobian or a rejected step it takes Levenberg-Marquardt
+// steps; when every start stalls, a hill climb on the dual gives the start.
+// Signed distance (table 5.2): d = sign(n_A . d_AB) |d_AB|, > 0 apart, < 0 overlap.
+#include <string>
+
+#include <Eigen/Core>
+
+#include "articula/contact/convex_shape.hpp"
+#include "articula/geometry/frames.hpp"
+
+namespace articula::contact {
+
+struct ContactOptions {
+  geometry::FrameMethod frame = geometry::FrameMethod::Householder;  // or SquarePlate
+  int max_iterations = 40;          // Newton iterations per start
+  double step_tolerance = 1e-13;    // stop when |delta u| (canonical, dimensionless) is below
+  double residual_tolerance = 1e-14;  // or when |Phi| (dimensionless) is below
+  int sample_directions = 64;       // dual samples for the global search (overlap)
+  int global_starts = 3;            // Newton starts from the best distinct samples
+  bool verify_warm_overlap = false;  // warm start and overlap: also run the global search
+  /// Throws UsageError naming the first bad field.
+  void validate() const;
+};
+
+enum class ContactStatus {
+  Converged,     // Newton converged; separated answers are certified global
+  NotConverged,  // no Newton start converged: the answer is the dual hill climb's
+};
+const char* statusName(ContactStatus status);  // "converged", "not_converged"
+
+struct ContactSummary {
+  ContactStatus status = ContactStatus::NotConverged;
+  std::string termination;   // why the solver stopped, in words
+  int iterations = 0;        // Newton iterations over every start
+  int starts = 0;            // Newton starts
+  int damped_steps = 0;      // Levenberg-Marquardt steps (singular Jacobian or rejected Newton step)
+  bool warm_started = false;
+  bool global_search = false;  // the dual was sampled
+  bool certified = false;      // separated: global minimum by concavity of the dual
+  double residual = 0.0;       // |Phi| at the answer
+  std::string briefReport() const;
+};
+
+struct ContactResult {
+  double distance = 0.0;                                    // signed, mm
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();        // on A (mm)
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();        // on B (mm)
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();        // unit outward normal of A at point_a
+  Eigen::Vector3d canonical_a = Eigen::Vector3d::UnitX();   // u_A: warm start of the next call
+  Eigen::Vector3d canonical_b = -Eigen::Vector3d::UnitX();  // u_B
+  ContactSummary summary;
+};
+
+/// The minimum signed distance between A and B. `warm_start` (the previous
+/// time step's result, section 5.4.5) seeds Newton; nullptr means cold.
+ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const ContactOptions& options = {},
+                             const ContactResult* warm_start = nullptr);
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+/// The residual Phi of eq. 5.23 (scaled as above, L = `length`) and its
+/// analytic Jacobian d Phi / d [u_A; u_B] at canonical points u_A, u_B.
+void commonNormalSystem(const ConvexShape& a, const ConvexShape& b, const Eigen::Vector3d& u_a,
+                        const Eigen::Vector3d& u_b, geometry::FrameMethod frame, double length, Vector6d& phi,
+                        Matrix6d& jacobian);
+
+/// The dual s(v) for a unit direction v (mm), with the support points.
+double dualSeparation(const ConvexShape& a, const ConvexShape& b, const Eigen::Vector3d& v,
+                      Eigen::Vector3d* u_a = nullptr, Eigen::Vector3d* u_b = nullptr);
+
+}  // namespace articula::contact

@@ -1,0 +1,107 @@
+#include "articula/contact/convex_shape.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+
+#include "articula/core/error.hpp"
+#include "articula/geometry/pose.hpp"
+#include "articula/geometry/power.hpp"
+
+namespace articula::contact {
+
+using Eigen::Vector3d;
+
+ConvexShape makeConvexShape(const Vector3d& center, const Eigen::Matrix3d& rotation, const Vector3d& radii,
+                            const Vector3d& exponents) {
+  static const char* radius_names[3] = {"a", "b", "c"};
+  static const char* exponent_names[3] = {"gamma1", "gamma2", "gamma3"};
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(radii[i]) || !(radii[i] > 0.0))
+      throw InvalidParameter(radius_names[i], "a finite radius > 0 mm", radii[i]);
+    if (!std::isfinite(exponents[i]) || !(exponents[i] >= 2.0))
+      throw InvalidParameter(exponent_names[i], "a finite exponent >= 2 (smooth and convex)", exponents[i]);
+    if (!std::isfinite(center[i])) throw InvalidParameter("center", "a finite coordinate (mm)", center[i]);
+  }
+  const double orthogonality = (rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!std::isfinite(orthogonality) || orthogonality > 1e-9)
+    throw InvalidParameter("rotation", "an orthonormal matrix (max |R^T R - I| <= 1e-9)", orthogonality);
+  if (rotation.determinant() < 0.0)
+    throw InvalidParameter("rotation", "a proper rotation (det +1)", rotation.determinant());
+  ConvexShape s;
+  s.center = center;
+  s.rotation = rotation;
+  s.radii = radii;
+  s.exponents = exponents;
+  s.quadric = (exponents.array() == 2.0).all();
+  return s;
+}
+
+ConvexShape shapeFromParameters(const geometry::ShapeParameters& p) {
+  using geometry::ShapeModel;
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(p.angles);
+  switch (p.model) {
+    case ShapeModel::Sphere: return makeConvexShape(p.center, R, Vector3d::Constant(p.radii[0]));
+    case ShapeModel::Ellipsoid: return makeConvexShape(p.center, R, p.radii);
+    case ShapeModel::Superellipsoid: return makeConvexShape(p.center, R, p.radii, p.exponents);
+    default:
+      throw UsageError("contact: model '" + geometry::modelName(p.model) +
+                       "' is not supported (expected sphere, ellipsoid or superellipsoid: the "
+                       "solver's start relies on central symmetry, which ovoids lack)");
+  }
+}
+
+CanonicalEvaluation evaluateCanonical(const ConvexShape& s, const Vector3d& u) {
+  if (s.quadric) return {u.squaredNorm() - 1.0, 2.0 * u, Vector3d::Constant(2.0)};
+  CanonicalEvaluation e{-1.0, Vector3d::Zero(), Vector3d::Zero()};
+  for (int i = 0; i < 3; ++i) {
+    const geometry::AbsPower t = geometry::absPower(u[i], s.exponents[i]);
+    e.value += t.value;
+    e.gradient[i] = t.first;
+    e.hessian_diagonal[i] = t.second;
+  }
+  return e;
+}
+
+Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
+  // max w . u subject to F(u) = 0, with w = D R^T v (v . x = w . u + v . c).
+  const Vector3d w = s.radii.cwiseProduct(s.rotation.transpose() * v);
+  if (s.quadric) return w / w.norm();
+  // Lagrange: w_i = lambda g_i |u_i|^(g_i-1) sgn(u_i), so with mu = 1/lambda,
+  // a_i = |w_i| / g_i and p_i = g_i / (g_i - 1): |u_i| = (mu a_i)^(p_i - 1),
+  // and F = 0 reads S(t) = sum_i exp(p_i (t + log a_i)) = 1 at t = log mu.
+  // log S is convex and increasing in t: Newton from a start with S >= 1
+  // decreases monotonically onto the root.
+  double log_a[3], p[3];
+  bool active[3];
+  double log_a_max = -INFINITY;
+  for (int i = 0; i < 3; ++i) {
+    active[i] = w[i] != 0.0;
+    log_a[i] = active[i] ? std::log(std::fabs(w[i]) / s.exponents[i]) : 0.0;
+    p[i] = s.exponents[i] / (s.exponents[i] - 1.0);
+    if (active[i]) log_a_max = std::max(log_a_max, log_a[i]);
+  }
+  double t = -log_a_max;  // the largest term is 1 here, so S >= 1
+  for (int iteration = 0; iteration < 60; ++iteration) {
+    double S = 0.0, dS = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      if (!active[i]) continue;
+      const double term = std::exp(p[i] * (t + log_a[i]));
+      S += term;
+      dS += p[i] * term;
+    }
+    const double log_S = std::log(S);
+    const double step = log_S * S / dS;
+    t -= step;
+    if (std::fabs(step) <= 1e-15 * (1.0 + std::fabs(t))) break;
+  }
+  Vector3d u = Vector3d::Zero();
+  for (int i = 0; i < 3; ++i)
+    if (active[i]) u[i] = std::copysign(std::exp((p[i] - 1.0) * (t + log_a[i])), w[i]);
+  return u;
+}
+
+double boundingRadius(const ConvexShape& s) { return s.quadric ? s.radii.maxCoeff() : s.radii.norm(); }
+
+}  // namespace articula::contact

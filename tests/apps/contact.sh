@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# articula contact end to end: the pairs CSV of testdata/contact (analytic
+# answers), per-row statuses for bad rows, exit code 3 when no row is valid,
+# and a thesis table 5.3 motion with warm starts.
+set -euo pipefail
+bin="$ARTICULA_BIN/articula"
+mkdir -p "$ARTICULA_TMP"
+out="$ARTICULA_TMP/contacts.csv"
+
+"$bin" contact --pairs "$ARTICULA_SOURCE/testdata/contact/pairs.csv" -o "$out" --force --json -q > "$ARTICULA_TMP/summary.json"
+grep -q '"ns_per_query"' "$ARTICULA_TMP/summary.json"
+grep -q '"valid_rows": 6' "$ARTICULA_TMP/summary.json"
+[ "$(wc -l < "$out")" -eq 10 ] || { echo "expected 9 rows + header"; exit 1; }
+head -1 "$out" | grep -qx 'distance,pax,pay,paz,pbx,pby,pbz,nx,ny,nz,iterations,status'
+# Expected distances per data row (invalid rows: status invalid).
+expected=(1 -0.5 4 -0.5 1 invalid invalid invalid 1)
+for i in "${!expected[@]}"; do
+  row=$(sed -n "$((i + 2))p" "$out")
+  want=${expected[$i]}
+  if [ "$want" = invalid ]; then
+    [ "${row##*,}" = invalid ] || { echo "row $((i + 1)): expected invalid, got $row"; exit 1; }
+  else
+    awk -F, -v w="$want" '{ d = $1 - w; if (d < 0) d = -d; exit !(d < 1e-12 && $12 == "converged") }' <<< "$row" \
+      || { echo "row $((i + 1)): expected distance $want, got $row"; exit 1; }
+  fi
+done
+
+# Only bad rows: exit code 3 and no output file.
+bad="$ARTICULA_TMP/bad.csv"
+{ head -1 "$ARTICULA_SOURCE/testdata/contact/pairs.csv"; sed -n '7,9p' "$ARTICULA_SOURCE/testdata/contact/pairs.csv"; } > "$bad"
+set +e
+"$bin" contact --pairs "$bad" -o "$ARTICULA_TMP/bad_out.csv" --force 2> "$ARTICULA_TMP/bad.err"
+rc=$?
+set -e
+[ "$rc" -eq 3 ] || { echo "expected exit code 3, got $rc"; exit 1; }
+grep -q 'bad.csv:2:' "$ARTICULA_TMP/bad.err"
+[ ! -e "$ARTICULA_TMP/bad_out.csv" ]
+
+# Table 5.3-3 motion: 200 warm-started steps, all converged, few iterations each.
+"$bin" contact --scenario table5.3-3 -o "$ARTICULA_TMP/motion.csv" --force --json -q > "$ARTICULA_TMP/motion.json"
+grep -q '"converged_steps": 200' "$ARTICULA_TMP/motion.json"
+[ "$(wc -l < "$ARTICULA_TMP/motion.csv")" -eq 201 ]
+awk -F'[:,]' '/iterations_per_warm_step/ { exit !($2 < 8) }' "$ARTICULA_TMP/motion.json"
+echo "contact app: OK"

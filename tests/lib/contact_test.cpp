@@ -1,0 +1,399 @@
+// Contact module: common-normal Newton solver, closed forms, proximity, scenarios.
+// Ground truth: analytic spheres and planes, and for ellipsoid pairs the
+// support-function dual max_v [v.(cB - cA) - sqrt(v'M_A v) - sqrt(v'M_B v)]
+// evaluated in long double by dense sampling plus a local ascent.
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "articula/contact/common_normal.hpp"
+#include "articula/contact/frame_derivatives.hpp"
+#include "articula/contact/plane_contact.hpp"
+#include "articula/contact/proximity.hpp"
+#include "articula/contact/reference.hpp"
+#include "articula/contact/scenario.hpp"
+#include "articula/core/error.hpp"
+#include "articula/geometry/surfaces.hpp"
+
+namespace {
+
+using namespace articula::contact;
+using articula::geometry::FrameMethod;
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+Matrix3d randomRotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+}
+
+ConvexShape randomShape(std::mt19937_64& rng, double r_min, double r_max, double g_max = 2.0) {
+  std::uniform_real_distribution<double> r(r_min, r_max), g(2.0, g_max);
+  const Vector3d exps = g_max > 2.0 ? Vector3d(g(rng), g(rng), g(rng)) : Vector3d::Constant(2.0);
+  return makeConvexShape(Vector3d::Zero(), randomRotation(rng), Vector3d(r(rng), r(rng), r(rng)), exps);
+}
+
+double referenceDistance(const ConvexShape& a, const ConvexShape& b) { return referenceEllipsoidDistance(a, b); }
+
+// ---------------------------------------------------------------- shape pieces
+
+TEST(ConvexShape, MatchesGeometryModule) {
+  std::mt19937_64 rng(1);
+  for (double g_max : {2.0, 4.0}) {
+    ConvexShape s = randomShape(rng, 0.5, 2.0, g_max);
+    s.center = Vector3d(1, -2, 3);
+    articula::geometry::Pose pose;
+    pose.rotation = s.rotation, pose.translation = s.center, pose.scale = s.radii;
+    const articula::geometry::Superellipsoid ref(pose, s.exponents);
+    std::normal_distribution<double> g;
+    for (int i = 0; i < 50; ++i) {
+      const Vector3d u(g(rng), g(rng), g(rng));
+      const auto e = evaluateCanonical(s, u);
+      const auto r = ref.evaluateCanonical(u, 2);
+      EXPECT_NEAR(e.value, r.value, 1e-12 * (1 + std::fabs(r.value)));
+      EXPECT_LT((e.gradient - r.gradient).norm(), 1e-11 * (1 + r.gradient.norm()));
+      EXPECT_LT((e.hessian_diagonal - r.hessian.diagonal()).norm(), 1e-11 * (1 + r.hessian.norm()));
+      EXPECT_LT((toGlobal(s, u) - pose.toGlobal(u)).norm(), 1e-12);
+    }
+  }
+}
+
+TEST(ConvexShape, SupportPointHasTheGivenNormal) {
+  std::mt19937_64 rng(2);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 200; ++i) {
+    const ConvexShape s = randomShape(rng, 0.3, 3.0, 5.0);
+    const Vector3d v = Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const Vector3d u = supportCanonical(s, v);
+    const auto e = evaluateCanonical(s, u);
+    EXPECT_NEAR(e.value, 0.0, 1e-13);
+    const Vector3d n = (s.rotation * e.gradient.cwiseQuotient(s.radii)).normalized();
+    EXPECT_GT(n.dot(v), 1.0 - 1e-13);
+  }
+}
+
+TEST(ConvexShape, RejectsBadParameters) {
+  EXPECT_THROW(makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 0, 1)), articula::InvalidParameter);
+  EXPECT_THROW(makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 1, 1), Vector3d(2, 1.5, 2)),
+               articula::InvalidParameter);
+  EXPECT_THROW(makeConvexShape(Vector3d(NAN, 0, 0), Matrix3d::Identity(), Vector3d(1, 1, 1)), articula::InvalidParameter);
+  EXPECT_THROW(makeConvexShape(Vector3d::Zero(), 2.0 * Matrix3d::Identity(), Vector3d(1, 1, 1)), articula::InvalidParameter);
+}
+
+TEST(Frames, DerivativesMatchFiniteDifferences) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g;
+  for (FrameMethod m : {FrameMethod::Householder, FrameMethod::SquarePlate}) {
+    for (int i = 0; i < 100; ++i) {
+      const Vector3d n = Vector3d(g(rng), g(rng), g(rng)).normalized();
+      const FrameWithDerivatives f = frameWithDerivatives(n, m);
+      EXPECT_NEAR(f.t.dot(n), 0.0, 1e-14);
+      EXPECT_NEAR(f.b.dot(n), 0.0, 1e-14);
+      EXPECT_LT((f.t.cross(f.b) - n).norm(), 1e-14);
+      // Along tangent directions of the sphere (where the formulas live).
+      for (const Vector3d& dir : {f.t, f.b}) {
+        const double h = 1e-6;
+        const Vector3d np = (n + h * dir).normalized(), nm = (n - h * dir).normalized();
+        const FrameWithDerivatives fp = frameWithDerivatives(np, m), fm = frameWithDerivatives(nm, m);
+        if ((np.x() > 0) != (nm.x() > 0) || (np.x() * np.y() >= 0) != (nm.x() * nm.y() >= 0)) continue;  // branch
+        EXPECT_LT(((fp.t - fm.t) / (2 * h) - f.dt_dn * dir).norm(), 1e-7);
+        EXPECT_LT(((fp.b - fm.b) / (2 * h) - f.db_dn * dir).norm(), 1e-7);
+      }
+    }
+  }
+}
+
+TEST(CommonNormal, AnalyticJacobianMatchesFiniteDifferences) {
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> g;
+  for (FrameMethod m : {FrameMethod::Householder, FrameMethod::SquarePlate}) {
+    for (int i = 0; i < 40; ++i) {
+      ConvexShape a = randomShape(rng, 0.5, 1.5, 4.0), b = randomShape(rng, 0.5, 1.5, 2.0);
+      b.center = Vector3d(g(rng), g(rng), g(rng)) * 2.0;
+      const Vector3d ua = Vector3d(g(rng), g(rng), g(rng)) * 0.6, ub = Vector3d(g(rng), g(rng), g(rng)) * 0.6;
+      Vector6d phi, p1, p2;
+      Matrix6d J, dummy;
+      commonNormalSystem(a, b, ua, ub, m, 1.7, phi, J);
+      for (int k = 0; k < 6; ++k) {
+        const double h = 1e-6;
+        Vector6d q;
+        q << ua, ub;
+        Vector6d qp = q, qm = q;
+        qp[k] += h, qm[k] -= h;
+        commonNormalSystem(a, b, qp.head<3>(), qp.tail<3>(), m, 1.7, p1, dummy);
+        commonNormalSystem(a, b, qm.head<3>(), qm.tail<3>(), m, 1.7, p2, dummy);
+        const Vector6d fd = (p1 - p2) / (2 * h);
+        if ((p1 - p2).cwiseAbs().maxCoeff() > 0.5) continue;  // frame branch switched between samples
+        EXPECT_LT((fd - J.col(k)).norm(), 2e-6 * (1 + J.col(k).norm())) << "column " << k;
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------- spheres and planes
+
+TEST(Contact, SpheresAnalytic) {
+  const Matrix3d I = Matrix3d::Identity();
+  const ConvexShape a = makeConvexShape(Vector3d(1, 2, 3), I, Vector3d::Constant(2.0));
+  const Vector3d dir = Vector3d(1, -2, 0.5).normalized();
+  for (double gap : {3.0, 0.1, 1e-6, 0.0, -1e-6, -0.3, -2.5}) {
+    const ConvexShape b = makeConvexShape(a.center + dir * (3.0 + gap), I, Vector3d::Constant(1.0));
+    const ContactResult r = computeContact(a, b);
+    EXPECT_EQ(r.summary.status, ContactStatus::Converged) << r.summary.briefReport();
+    EXPECT_NEAR(r.distance, gap, 1e-12) << "gap " << gap;
+    EXPECT_LT((r.normal - dir).norm(), 1e-9);
+    EXPECT_LT((r.point_a - (a.center + 2.0 * dir)).norm(), 1e-9);
+    EXPECT_LT((r.point_b - (b.center - 1.0 * dir)).norm(), 1e-9);
+  }
+}
+
+TEST(Contact, PointPlane) {
+  EXPECT_DOUBLE_EQ(pointPlaneDistance(Vector3d(1, 2, 5), Vector3d(0, 0, 2), Vector3d(0, 0, 3)), 3.0);
+  EXPECT_DOUBLE_EQ(pointPlaneDistance(Vector3d(1, 2, -1), Vector3d(0, 0, 2), Vector3d(0, 0, 1)), -3.0);
+}
+
+TEST(Contact, AxisAlignedEllipsoidAndPlane) {
+  // Ellipsoid radii (3, 2, 1) at height h over the plane z = 0: distance h - 1.
+  for (double h : {5.0, 1.0, 0.5, -0.5}) {
+    const ConvexShape e = makeConvexShape(Vector3d(1, 1, h), Matrix3d::Identity(), Vector3d(3, 2, 1));
+    const ContactResult r = shapePlaneContact(e, Vector3d(7, -3, 0), Vector3d(0, 0, 2));
+    EXPECT_NEAR(r.distance, h - 1.0, 1e-14);
+    EXPECT_LT((r.point_a - Vector3d(1, 1, h - 1)).norm(), 1e-14);
+    EXPECT_LT((r.point_b - Vector3d(1, 1, 0)).norm(), 1e-14);
+  }
+  // Tilted plane z = x: distance of an ellipsoid at the origin is -support along n.
+  const ConvexShape e = makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(3, 2, 1));
+  const Vector3d n = Vector3d(-1, 0, 1).normalized();
+  const double h = std::sqrt(9 * n.x() * n.x() + n.z() * n.z());
+  EXPECT_NEAR(shapePlaneContact(e, Vector3d::Zero(), n).distance, -h, 1e-14);
+}
+
+TEST(Contact, SuperellipsoidPlaneMatchesDenseSearch) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 20; ++i) {
+    ConvexShape s = randomShape(rng, 0.5, 2.0, 4.0);
+    s.center = Vector3d(g(rng), g(rng), g(rng));
+    const Vector3d n = Vector3d(g(rng), g(rng), g(rng)).normalized(), p(g(rng), g(rng), g(rng));
+    const ContactResult r = shapePlaneContact(s, p, n);
+    // On the surface, on the plane, normal -n.
+    EXPECT_NEAR(evaluateCanonical(s, toCanonical(s, r.point_a)).value, 0.0, 1e-12);
+    EXPECT_NEAR(n.dot(r.point_b - p), 0.0, 1e-12);
+    // Dense parametric sample (geometry module) never goes lower.
+    articula::geometry::Pose pose;
+    pose.rotation = s.rotation, pose.translation = s.center, pose.scale = s.radii;
+    const articula::geometry::Superellipsoid ref(pose, s.exponents);
+    double lowest = 1e300;
+    for (int ia = 0; ia < 400; ++ia)
+      for (int il = 0; il <= 200; ++il)
+        lowest = std::min(lowest, n.dot(pose.toGlobal(ref.canonicalPoint(-M_PI + 2 * M_PI * ia / 400.0,
+                                                                          -M_PI / 2 + M_PI * il / 200.0)) - p));
+    EXPECT_LE(r.distance, lowest + 1e-12);
+    EXPECT_GT(r.distance, lowest - 2e-3);
+  }
+}
+
+TEST(Contact, BarrPlaneClosedForm) {
+  std::mt19937_64 rng(6);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> e(0.3, 1.0);
+  for (int i = 0; i < 50; ++i) {
+    const double e1 = e(rng), e2 = e(rng);
+    const Vector3d radii(0.5 + std::fabs(g(rng)), 0.5 + std::fabs(g(rng)), 0.5 + std::fabs(g(rng)));
+    const Matrix3d R = randomRotation(rng);
+    const Vector3d c(g(rng), g(rng), g(rng)), n = Vector3d(g(rng), g(rng), g(rng)).normalized(), p(g(rng), g(rng), g(rng));
+    const ContactResult r = barrPlaneContact(c, R, radii, e1, e2, p, n);
+    articula::geometry::Pose pose;
+    pose.rotation = R, pose.translation = c, pose.scale = radii;
+    const articula::geometry::BarrSuperellipsoid barr(pose, e1, e2);
+    const auto ev = barr.evaluate(r.point_a, 1);
+    EXPECT_NEAR(ev.value, 0.0, 1e-10);
+    EXPECT_GT(ev.gradient.normalized().dot(-n), 1.0 - 1e-10) << "e1 " << e1 << " e2 " << e2;
+    EXPECT_NEAR(r.distance, n.dot(r.point_a - p), 1e-12);
+  }
+  // e1 = e2 = 1 is the ellipsoid.
+  const ConvexShape ell = makeConvexShape(Vector3d(1, 2, 3), Matrix3d::Identity(), Vector3d(3, 2, 1));
+  const Vector3d n = Vector3d(1, 2, -2).normalized();
+  EXPECT_NEAR(barrPlaneContact(ell.center, ell.rotation, ell.radii, 1, 1, Vector3d::Zero(), n).distance,
+              shapePlaneContact(ell, Vector3d::Zero(), n).distance, 1e-13);
+  // The pole (0, 0, c): 0/0 in eq. 5.14.
+  EXPECT_NEAR(barrPlaneContact(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 1, 2), 0.5, 0.7,
+                               Vector3d(0, 0, -3), Vector3d(0, 0, 1)).distance, 1.0, 1e-14);
+}
+
+// ---------------------------------------------------------------- ellipsoid pairs
+
+// Places b so that the reference distance lands near `target` (separated > 0, overlap < 0).
+void placeAt(ConvexShape& a, ConvexShape& b, std::mt19937_64& rng, double target) {
+  std::normal_distribution<double> g;
+  const Vector3d dir = Vector3d(g(rng), g(rng), g(rng)).normalized();
+  // Centre distance where the extents along dir sum to the target gap.
+  const double ea = dir.dot(toGlobal(a, supportCanonical(a, dir)) - a.center);
+  const double eb = -dir.dot(toGlobal(b, supportCanonical(b, -dir)) - b.center);
+  b.center = a.center + dir * (ea + eb + target);
+}
+
+struct PairClass {
+  const char* name;
+  double gap_min, gap_max;
+};
+
+TEST(Contact, EllipsoidPairsAgainstReference) {
+  std::mt19937_64 rng(7);
+  for (const PairClass& c : {PairClass{"separated", 0.05, 1.0}, PairClass{"shallow", -0.05, 0.0},
+                             PairClass{"deep", -1.0, -0.2}}) {
+    std::uniform_real_distribution<double> gap(c.gap_min, c.gap_max);
+    double worst = 0.0;
+    for (int i = 0; i < 60; ++i) {
+      ConvexShape a = randomShape(rng, 0.5, 1.5), b = randomShape(rng, 0.5, 1.5);
+      placeAt(a, b, rng, gap(rng));
+      const double ref = referenceDistance(a, b);
+      const ContactResult r = computeContact(a, b);
+      EXPECT_EQ(r.summary.status, ContactStatus::Converged) << c.name << " " << r.summary.briefReport();
+      worst = std::max(worst, std::fabs(r.distance - ref));
+      EXPECT_NEAR(r.distance, ref, 1e-10) << c.name << " pair " << i << ": " << r.summary.briefReport();
+      // The pair is a common-normal pair: both points on the surfaces, normals opposite, d along n.
+      EXPECT_NEAR(evaluateCanonical(a, toCanonical(a, r.point_a)).value, 0.0, 1e-10);
+      EXPECT_NEAR(evaluateCanonical(b, toCanonical(b, r.point_b)).value, 0.0, 1e-10);
+      EXPECT_LT(((r.point_b - r.point_a) - r.distance * r.normal).norm(), 1e-9);
+      // Swapping A and B: same distance, points swapped, normal reversed.
+      const ContactResult s = computeContact(b, a);
+      EXPECT_NEAR(s.distance, r.distance, 1e-10);
+      if (c.gap_min >= 0.0) {  // unique answer when separated
+        EXPECT_LT((s.point_a - r.point_b).norm(), 1e-7);
+        EXPECT_LT((s.normal + r.normal).norm(), 1e-7);
+      }
+    }
+    std::printf("  %s: worst |error| %.3g mm\n", c.name, worst);
+  }
+}
+
+TEST(Contact, HighAspectEllipsoidsAgainstReference) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> gap(-0.5, 0.5);
+  for (int i = 0; i < 60; ++i) {
+    ConvexShape a = randomShape(rng, 0.15, 1.5), b = randomShape(rng, 0.15, 1.5);
+    placeAt(a, b, rng, gap(rng));
+    const double ref = referenceDistance(a, b);
+    const ContactResult r = computeContact(a, b);
+    EXPECT_NEAR(r.distance, ref, 1e-10) << "pair " << i << ": " << r.summary.briefReport();
+  }
+}
+
+TEST(Contact, SuperellipsoidPairsAreGlobalCommonNormalPairs) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> gap(-0.4, 0.4);
+  for (int i = 0; i < 60; ++i) {
+    ConvexShape a = randomShape(rng, 0.5, 1.5, 4.0), b = randomShape(rng, 0.5, 1.5, 4.0);
+    placeAt(a, b, rng, gap(rng));
+    const ContactResult r = computeContact(a, b);
+    EXPECT_EQ(r.summary.status, ContactStatus::Converged) << r.summary.briefReport();
+    EXPECT_NEAR(evaluateCanonical(a, toCanonical(a, r.point_a)).value, 0.0, 1e-9);
+    EXPECT_NEAR(evaluateCanonical(b, toCanonical(b, r.point_b)).value, 0.0, 1e-9);
+    EXPECT_LT(((r.point_b - r.point_a) - r.distance * r.normal).norm(), 1e-8);
+    // The dual is a lower bound everywhere, and reaches the answer at the normal.
+    double sampled = -1e300;
+    for (int k = 0; k < 3000; ++k) {
+      const double z = 1.0 - (2.0 * k + 1.0) / 3000, rr = std::sqrt(1 - z * z), t = 2.399963229728653 * k;
+      sampled = std::max(sampled, dualSeparation(a, b, Vector3d(rr * std::cos(t), rr * std::sin(t), z)));
+    }
+    EXPECT_GE(r.distance, sampled - 1e-10) << "pair " << i << ": " << r.summary.briefReport();
+    EXPECT_NEAR(dualSeparation(a, b, r.normal), r.distance, 1e-9);
+  }
+}
+
+TEST(Contact, SymmetricConfigurationsWithSeveralSolutions) {
+  // Fig. 5.13: a sphere and an aligned ellipsoid along a symmetry axis; the
+  // centre start sits exactly on a common-normal solution.
+  const Matrix3d I = Matrix3d::Identity();
+  const ConvexShape sphere = makeConvexShape(Vector3d::Zero(), I, Vector3d::Constant(1.0));
+  for (double gap : {0.5, -0.2}) {
+    const ConvexShape ell = makeConvexShape(Vector3d(0, 0, 1 + 2 + gap), I, Vector3d(1, 1, 2));
+    EXPECT_NEAR(computeContact(sphere, ell).distance, gap, 1e-12);
+  }
+  // Side by side along x: nearest points at x = 1 and x = 3 - 1.
+  const ConvexShape ell = makeConvexShape(Vector3d(3.0, 0, 0), I, Vector3d(1, 1, 2));
+  EXPECT_NEAR(computeContact(sphere, ell).distance, 1.0, 1e-12);
+  // Concentric bodies: the depth is the smallest sum of extents, -(1 + 1).
+  const ConvexShape inner = makeConvexShape(Vector3d::Zero(), I, Vector3d(1, 3, 2));
+  EXPECT_NEAR(computeContact(sphere, inner).distance, -2.0, 1e-12);
+}
+
+TEST(Contact, HouseholderAndSquarePlateAgree) {
+  std::mt19937_64 rng(10);
+  std::uniform_real_distribution<double> gap(-0.3, 0.5);
+  ContactOptions sp;
+  sp.frame = FrameMethod::SquarePlate;
+  for (int i = 0; i < 40; ++i) {
+    ConvexShape a = randomShape(rng, 0.5, 1.5, 3.0), b = randomShape(rng, 0.5, 1.5, 3.0);
+    placeAt(a, b, rng, gap(rng));
+    const ContactResult h = computeContact(a, b), s = computeContact(a, b, sp);
+    EXPECT_NEAR(h.distance, s.distance, 1e-10);
+    EXPECT_LT((h.point_a - s.point_a).norm(), 1e-6);
+  }
+}
+
+TEST(Contact, WarmStartsFollowAMotion) {
+  // Table 5.3-3 motion: warm starts agree with cold solves and need few iterations.
+  ContactResult previous;
+  int total_iterations = 0;
+  for (int k = 0; k < 200; ++k) {
+    const ScenarioPair p = scenarioPair("table5.3-3", k);
+    const ContactResult cold = computeContact(p.i, p.j);
+    const ContactResult warm = computeContact(p.i, p.j, {}, k ? &previous : nullptr);
+    EXPECT_NEAR(warm.distance, cold.distance, 1e-10) << "step " << k;
+    EXPECT_NEAR(warm.distance, referenceDistance(p.i, p.j), 1e-10) << "step " << k;
+    if (k) {
+      EXPECT_LT((warm.point_a - previous.point_a).norm(), 0.5) << "the contact point jumps at step " << k;
+      total_iterations += warm.summary.iterations;
+    }
+    previous = warm;
+  }
+  EXPECT_LT(total_iterations / 199.0, 6.0);
+}
+
+TEST(Contact, OptionsAreValidated) {
+  ContactOptions o;
+  o.max_iterations = 0;
+  EXPECT_THROW(o.validate(), articula::UsageError);
+  o = {};
+  o.frame = FrameMethod::Duff;
+  EXPECT_THROW(o.validate(), articula::UsageError);
+  o = {};
+  o.step_tolerance = -1;
+  EXPECT_THROW(o.validate(), articula::UsageError);
+  o = {};
+  o.global_starts = 1000;
+  EXPECT_THROW(o.validate(), articula::UsageError);
+}
+
+// ---------------------------------------------------------------- proximity
+
+TEST(Proximity, BoundingSpheresAndExactSeparation) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> gap(-0.5, 0.5);
+  int checked = 0;
+  for (int i = 0; i < 200; ++i) {
+    ConvexShape a = randomShape(rng, 0.5, 1.5), b = randomShape(rng, 0.5, 1.5);
+    placeAt(a, b, rng, gap(rng));
+    const double d = referenceDistance(a, b);
+    if (d <= 0.0) {
+      EXPECT_TRUE(boundingSpheresOverlap(a, b));
+    }
+    if (std::fabs(d) < 1e-6) continue;
+    ++checked;
+    EXPECT_EQ(ellipsoidRelation(a, b), d > 0 ? EllipsoidRelation::Separated : EllipsoidRelation::Overlapping)
+        << "distance " << d;
+  }
+  EXPECT_GT(checked, 190);
+  const Matrix3d I = Matrix3d::Identity();
+  const ConvexShape s1 = makeConvexShape(Vector3d::Zero(), I, Vector3d::Constant(1.0));
+  const ConvexShape s2 = makeConvexShape(Vector3d(2.0, 0, 0), I, Vector3d::Constant(1.0));
+  EXPECT_EQ(ellipsoidRelation(s1, s2), EllipsoidRelation::Touching);
+  const ConvexShape far = makeConvexShape(Vector3d(10.0, 0, 0), I, Vector3d::Constant(1.0));
+  EXPECT_FALSE(boundingSpheresOverlap(s1, far));
+}
+
+}  // namespace
