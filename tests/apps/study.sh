@@ -84,7 +84,8 @@ if command -v snakemake > /dev/null; then
   diff "$tmp/batch-good/study.csv" "$tmp/snake/study.csv" || fail "snakemake study.csv differs from batch"
   diff "$tmp/batch-good/study_summary.csv" "$tmp/snake/study_summary.csv" || fail "study_summary.csv differs"
   # Same seed, same outputs (batch-good vs the first batch, subject p2).
-  cmp "$tmp/study/subjects/p2/fits.csv" "$tmp/batch-good/subjects/p2/fits.csv" || fail "same seed, different fits"
+  cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-good/subjects/p2/points.ply" || fail "same seed, different points"
+  cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-good/subjects/p2/results.csv" || fail "same seed, different fits"
 else
   echo "snakemake not installed: Snakemake comparison skipped" >&2
 fi
