@@ -11,6 +11,8 @@ PACKAGES=(
   libgtest-dev libbenchmark-dev
   # measured peers (contact benchmarks) and the multibody engine
   libsimbody-dev libfcl-dev libccd-dev libbullet-dev
+  # studies that outgrow one machine (pipelines/Snakefile)
+  snakemake
 )
 
 missing=()
