@@ -28,8 +28,8 @@ std::string objectiveName(Objective o);
 Objective objectiveFromName(const std::string& name);
 
 enum class Strategy {
-  Local,        // LN_BOBYQA from the hierarchical start
-  GlobalLocal,  // GN_CRS2_LM within the bounds (seeded, capped), then LN_BOBYQA
+  Local,        // local_algorithm from the hierarchical start (default)
+  GlobalLocal,  // GN_CRS2_LM within the bounds (seeded, capped), then local_algorithm
 };
 std::string strategyName(Strategy s);
 Strategy strategyFromName(const std::string& name);
