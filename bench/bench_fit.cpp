@@ -12,6 +12,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
+#include "articula/fit/synthetic_cap.hpp"
 #include "articula/geometry/surface.hpp"
 
 namespace {
@@ -34,32 +35,8 @@ ShapeParameters headShape(ShapeModel model) {
   return p;
 }
 
-// 1,600 points on a 100-degree cap (a little beyond a hemisphere), moved
-// along the normal by Gaussian noise of `sigma` mm.
-Eigen::MatrixX3d capPoints(const ShapeParameters& p, int n, double sigma) {
-  const auto s = articula::geometry::makeSurface(p);
-  std::mt19937 rng(11);
-  std::normal_distribution<double> noise(0.0, sigma);
-  Eigen::MatrixX3d pts(n, 3);
-  const double z_min = std::cos(100.0 * M_PI / 180.0);
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (1.0 - z_min) * (i + 0.5) / n;
-    const double az = i * M_PI * (3.0 - std::sqrt(5.0));
-    const Vector3d dir(std::sqrt(1 - z * z) * std::cos(az), std::sqrt(1 - z * z) * std::sin(az), z);
-    double lo = 0.0, hi = 4.0;
-    for (int k = 0; k < 80; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (s->evaluateCanonical(mid * dir, 0).value < 0 ? lo : hi) = mid;
-    }
-    Vector3d x = s->pose().toGlobal(0.5 * (lo + hi) * dir);
-    x += noise(rng) * s->gradient(x).normalized();
-    pts.row(i) = x.transpose();
-  }
-  return pts;
-}
-
 const Eigen::MatrixX3d& headPoints() {
-  static const Eigen::MatrixX3d pts = capPoints(headShape(ShapeModel::Superovoid), 1600, 0.3);
+  static const Eigen::MatrixX3d pts = articula::fit::syntheticCap(headShape(ShapeModel::Superovoid), 100.0 * M_PI / 180.0, 1600, 0.3, 11);
   return pts;
 }
 

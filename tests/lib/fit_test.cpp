@@ -11,6 +11,7 @@
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/parameter_gradient.hpp"
+#include "articula/fit/synthetic_cap.hpp"
 #include "articula/geometry/surface.hpp"
 
 namespace {
@@ -35,32 +36,6 @@ ShapeParameters trueShape(ShapeModel model) {
   return p;
 }
 
-// Points on the cap within `half_angle` of the local +z axis (a golden-angle
-// spiral of directions, mapped onto the surface radially), optionally moved
-// along the normal by Gaussian noise.
-Eigen::MatrixX3d capPoints(const ShapeParameters& p, double half_angle, int n, double sigma, unsigned seed) {
-  const auto s = articula::geometry::makeSurface(p);
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, sigma);
-  Eigen::MatrixX3d pts(n, 3);
-  const double z_min = std::cos(half_angle);
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (1.0 - z_min) * (i + 0.5) / n;
-    const double az = i * M_PI * (3.0 - std::sqrt(5.0));
-    const Vector3d dir(std::sqrt(1 - z * z) * std::cos(az), std::sqrt(1 - z * z) * std::sin(az), z);
-    double lo = 0.0, hi = 4.0;  // radial projection in canonical coordinates
-    for (int k = 0; k < 80; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (s->evaluateCanonical(mid * dir, 0).value < 0 ? lo : hi) = mid;
-    }
-    Vector3d x = s->pose().toGlobal(0.5 * (lo + hi) * dir);
-    if (sigma > 0.0) x += noise(rng) * s->gradient(x).normalized();
-    pts.row(i) = x.transpose();
-  }
-  return pts;
-}
-
-// Each child's RMS <= its parent's (+1e-9 mm), for the models present.
 void expectNested(const Summary& s) {
   const std::pair<ShapeModel, ShapeModel> edges[] = {{ShapeModel::Ellipsoid, ShapeModel::Sphere},
                                                      {ShapeModel::Superellipsoid, ShapeModel::Ellipsoid},
@@ -80,14 +55,14 @@ void expectNested(const Summary& s) {
 
 TEST(AlgebraicStart, SphereAndEllipsoidExactOnExactPoints) {
   const ShapeParameters e = trueShape(ShapeModel::Ellipsoid);
-  const Eigen::MatrixX3d pts = capPoints(e, 1.2, 400, 0.0, 1);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(e, 1.2, 400, 0.0, 1);
   const ShapeParameters fit = articula::fit::algebraicEllipsoid(pts);
   EXPECT_LT((fit.center - e.center).norm(), 1e-6);
   Eigen::Vector3d r = fit.radii, rt = e.radii;
   std::sort(r.data(), r.data() + 3);
   std::sort(rt.data(), rt.data() + 3);
   EXPECT_LT((r - rt).norm(), 1e-6);
-  const ShapeParameters s = articula::fit::algebraicSphere(capPoints(trueShape(ShapeModel::Sphere), 1.0, 300, 0.0, 1));
+  const ShapeParameters s = articula::fit::algebraicSphere(articula::fit::syntheticCap(trueShape(ShapeModel::Sphere), 1.0, 300, 0.0, 1));
   EXPECT_NEAR(s.radii[0], 23.0, 1e-9);
   EXPECT_LT((s.center - Vector3d(-35.0, 12.0, 160.0)).norm(), 1e-9);
 }
@@ -95,7 +70,7 @@ TEST(AlgebraicStart, SphereAndEllipsoidExactOnExactPoints) {
 TEST(ParameterGradient, MatchesFiniteDifferencesForEveryModel) {
   for (ShapeModel model : articula::geometry::allModels()) {
     const ShapeParameters p = trueShape(model);
-    const Eigen::MatrixX3d at = capPoints(p, 1.5, 50, 0.8, 6);
+    const Eigen::MatrixX3d at = articula::fit::syntheticCap(p, 1.5, 50, 0.8, 6);
     Eigen::MatrixXd J;
     Eigen::VectorXd norms;
     articula::fit::parameterGradient(p, at, J, norms);
@@ -126,7 +101,7 @@ class RecoveryTest : public ::testing::TestWithParam<ShapeModel> {};
 TEST_P(RecoveryTest, NoiseFreeCapRecoversParameters) {
   const ShapeModel model = GetParam();
   const ShapeParameters truth = trueShape(model);
-  const Eigen::MatrixX3d pts = capPoints(truth, 100.0 * M_PI / 180.0, 600, 0.0, 2);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(truth, 100.0 * M_PI / 180.0, 600, 0.0, 2);
   Options o;
   // The true model and its ancestors (which are fitted anyway).
   o.models.clear();
@@ -170,7 +145,7 @@ TEST_P(RecoveryTest, NoiseFreeCapRecoversParameters) {
 // With sigma = 0.1 mm along the normal, the true model's RMS is sigma to 5%.
 TEST_P(RecoveryTest, NoisyCapRmsMatchesSigma) {
   const ShapeModel model = GetParam();
-  const Eigen::MatrixX3d pts = capPoints(trueShape(model), 80.0 * M_PI / 180.0, 1600, 0.1, 3);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(model), 80.0 * M_PI / 180.0, 1600, 0.1, 3);
   const Summary s = articula::fit::fitHierarchy(pts, Options{});
   expectNested(s);
   EXPECT_NEAR(s.fit(model).rms_mm, 0.1, 0.005);
@@ -184,8 +159,33 @@ INSTANTIATE_TEST_SUITE_P(AllModels, RecoveryTest,
                                            ShapeModel::Ovoid, ShapeModel::Superovoid),
                          [](const auto& param_info) { return articula::geometry::modelName(param_info.param); });
 
+// A 60-degree cap determines the ellipsoid's radii poorly: over five noise
+// realisations the fit stays as good as the noise (RMS within 5 % of sigma,
+// never worse than the truth), and the spread of the radii is reported, not
+// asserted to be small.
+TEST(FitHierarchy, SmallCapFitsTheNoiseAndReportsRadiusSpread) {
+  const ShapeParameters truth = trueShape(ShapeModel::Ellipsoid);
+  Options o;
+  o.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid};
+  Eigen::MatrixXd radii(5, 3);
+  for (int k = 0; k < 5; ++k) {
+    const Eigen::MatrixX3d pts = articula::fit::syntheticCap(truth, 60.0 * M_PI / 180.0, 800, 0.1, 20 + k);
+    const Summary s = articula::fit::fitHierarchy(pts, o);
+    const double truth_rms = std::sqrt(articula::fit::geometricObjective(truth, pts) / 800.0);
+    EXPECT_NEAR(s.fit(ShapeModel::Ellipsoid).rms_mm, 0.1, 0.005);
+    EXPECT_LE(s.fit(ShapeModel::Ellipsoid).rms_mm, truth_rms + 1e-9);
+    Vector3d r = s.fit(ShapeModel::Ellipsoid).parameters.radii;
+    std::sort(r.data(), r.data() + 3);
+    radii.row(k) = r.transpose();
+  }
+  const Eigen::RowVector3d mean = radii.colwise().mean();
+  const Eigen::RowVector3d spread = ((radii.rowwise() - mean).array().square().colwise().sum() / 4.0).sqrt();
+  std::cout << "60-degree cap, 5 noise realisations: sorted radii mean " << mean << " mm, std " << spread
+            << " mm (truth 20 22 25)\n";
+}
+
 TEST(FitHierarchy, DeterministicForAFixedSeed) {
-  const Eigen::MatrixX3d pts = capPoints(trueShape(ShapeModel::Superovoid), 1.0, 800, 0.1, 4);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Superovoid), 1.0, 800, 0.1, 4);
   Options o;
   o.strategy = articula::fit::Strategy::GlobalLocal;
   o.global_evaluations = 300;
@@ -199,7 +199,7 @@ TEST(FitHierarchy, DeterministicForAFixedSeed) {
 }
 
 TEST(FitHierarchy, AlgebraicObjectiveKeepsNesting) {
-  const Eigen::MatrixX3d pts = capPoints(trueShape(ShapeModel::Ovoid), 1.3, 600, 0.1, 5);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Ovoid), 1.3, 600, 0.1, 5);
   Options o;
   o.objective = articula::fit::Objective::Algebraic;
   expectNested(articula::fit::fitHierarchy(pts, o));
@@ -208,7 +208,7 @@ TEST(FitHierarchy, AlgebraicObjectiveKeepsNesting) {
 TEST(FitHierarchy, RejectsBadOptionsAndTooFewPoints) {
   Options o;
   o.bounds["gamma9"] = {2.0, 3.0};
-  const Eigen::MatrixX3d pts = capPoints(trueShape(ShapeModel::Sphere), 1.0, 100, 0.0, 1);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Sphere), 1.0, 100, 0.0, 1);
   EXPECT_THROW(articula::fit::fitHierarchy(pts, o), articula::UsageError);
   EXPECT_THROW(articula::fit::fitHierarchy(pts.topRows(10), Options{}), articula::InputError);
 }

@@ -139,10 +139,11 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
     }
   }
   const double dist = (y - q).norm();
-  const double f_y = evaluateLocal(*surface_, inv_r, y).value;
-  // A foot point must see y on the correct side of its tangent plane.
-  if (dist > 1e-9 * scale && (mu < 0.0) != (f_y < 0.0)) return false;
-  result.distance = f_y < 0.0 ? -dist : dist;
+  // y = q + mu grad F(q): the sign of mu says which side of the tangent plane
+  // y is, which for a convex body is inside or outside. Very near the surface
+  // F(y) itself decides.
+  const bool inside = dist > 1e-6 * scale ? mu < 0.0 : evaluateLocal(*surface_, inv_r, y).value < 0.0;
+  result.distance = inside ? -dist : dist;
   result.point = q;
   return true;
 }

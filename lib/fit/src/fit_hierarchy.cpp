@@ -485,7 +485,8 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
                                    points, o);
   std::vector<std::pair<std::string, ShapeParameters>> e_starts{{"sphere", sphere.parameters}};
   if (have_algebraic_ellipsoid) e_starts.emplace_back("algebraic", ellipsoid_start);
-  ModelFit ellipsoid = fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o);
+  ModelFit ellipsoid =
+      fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o, o.screening_evaluations);
   enforceNesting(ellipsoid, sphere, points);
 
   auto wanted = [&](ShapeModel m) { return std::find(o.models.begin(), o.models.end(), m) != o.models.end(); };
@@ -508,7 +509,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
                            {"ovoid", ovoid.parameters},
                            {"ovoid with the superellipsoid's exponents",
                             combineParents(superellipsoid.parameters, ovoid.parameters)}},
-                          bounds(ShapeModel::Superovoid), points, o);
+                          bounds(ShapeModel::Superovoid), points, o, o.screening_evaluations);
     enforceNesting(superovoid, superellipsoid.rms_mm <= ovoid.rms_mm ? superellipsoid : ovoid, points);
   }
 

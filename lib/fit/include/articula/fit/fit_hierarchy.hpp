@@ -28,8 +28,8 @@ std::string objectiveName(Objective o);
 Objective objectiveFromName(const std::string& name);
 
 enum class Strategy {
-  Local,        // LN_BOBYQA from the hierarchical start
-  GlobalLocal,  // GN_CRS2_LM within the bounds (seeded, capped), then LN_BOBYQA
+  Local,        // local_algorithm from the hierarchical start (default)
+  GlobalLocal,  // GN_CRS2_LM within the bounds (seeded, capped), then local_algorithm
 };
 std::string strategyName(Strategy s);
 Strategy strategyFromName(const std::string& name);
@@ -43,7 +43,7 @@ struct Options {
   int max_evaluations = 4000;          // per local run
   int global_evaluations = 3000;       // per global run (GlobalLocal)
   int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
-  int screening_evaluations = 40;      // ovoid: per axis labelling of the ellipsoid, before the best is finished
+  int screening_evaluations = 40;      // models with several starts: evaluations per start before the best is finished
   double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
   double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
   // Bounds (thesis section 3.2.5), around the reference ellipsoid start:
