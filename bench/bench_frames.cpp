@@ -70,7 +70,7 @@ void runFrames(benchmark::State& state) {
   state.counters["err_b_norm"] = w.b_norm;
   state.counters["err_right_handed"] = w.handed;
   state.counters["ns_per_frame"] = benchmark::Counter(
-      static_cast<double>(state.iterations() * count), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+      static_cast<double>(state.iterations() * count) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 namespace g = articula::geometry;

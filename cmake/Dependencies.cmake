@@ -11,6 +11,9 @@ endmacro()
 find_package(Eigen3 3.4 QUIET NO_MODULE)
 articula_require(Eigen3_FOUND libeigen3-dev)
 
+find_package(OpenSSL QUIET)
+articula_require(OpenSSL_FOUND libssl-dev)
+
 find_package(CLI11 QUIET CONFIG)
 articula_require(CLI11_FOUND libcli11-dev)
 

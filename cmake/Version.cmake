@@ -1,12 +1,10 @@
-# Version and git commit, baked into lib/core so every result file can carry them.
-find_package(Git QUIET)
-set(ARTICULA_GIT_COMMIT "unknown")
-if(GIT_FOUND AND EXISTS ${CMAKE_SOURCE_DIR}/.git)
-  execute_process(COMMAND ${GIT_EXECUTABLE} rev-parse --short=12 HEAD
-    WORKING_DIRECTORY ${CMAKE_SOURCE_DIR}
-    OUTPUT_VARIABLE ARTICULA_GIT_COMMIT OUTPUT_STRIP_TRAILING_WHITESPACE
-    ERROR_QUIET RESULT_VARIABLE _git_rc)
-  if(NOT _git_rc EQUAL 0)
-    set(ARTICULA_GIT_COMMIT "unknown")
-  endif()
-endif()
+# Version and git commit baked into lib/core, so every result file carries
+# them. The commit is read at every build (not only at configure time), and
+# version.cpp is rewritten only when it changes.
+set(ARTICULA_VERSION_CPP ${CMAKE_BINARY_DIR}/generated/version.cpp)
+add_custom_target(articula_version_info
+  COMMAND ${CMAKE_COMMAND} -DSOURCE_DIR=${CMAKE_SOURCE_DIR} -DVERSION=${PROJECT_VERSION}
+          -DTEMPLATE=${CMAKE_SOURCE_DIR}/lib/core/src/version.cpp.in -DOUTPUT=${ARTICULA_VERSION_CPP}
+          -P ${CMAKE_SOURCE_DIR}/cmake/GenerateVersion.cmake
+  BYPRODUCTS ${ARTICULA_VERSION_CPP}
+  COMMENT "Reading the git commit")

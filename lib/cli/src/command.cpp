@@ -95,10 +95,10 @@ void describe(CLI::App& app, const Command& command) {
 
 }  // namespace
 
-int runCommandMain(int argc, char** argv, std::unique_ptr<Command> command) {
-  setCommandLine(argc, argv);
+namespace {
+int runSingle(int argc, char** argv, const std::string& program, std::unique_ptr<Command> command) {
   CLI::App app;
-  app.name("articula-" + command->name());
+  app.name(program);
   describe(app, *command);
   CommonOptions common;
   addCommonOptions(app, common);
@@ -113,9 +113,23 @@ int runCommandMain(int argc, char** argv, std::unique_ptr<Command> command) {
     return command->run(common);
   });
 }
+}  // namespace
+
+int runCommandMain(int argc, char** argv, std::unique_ptr<Command> command) {
+  setCommandLine(argc, argv);
+  const std::string program = "articula-" + command->name();
+  return runSingle(argc, argv, program, std::move(command));
+}
 
 int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> commands) {
   setCommandLine(argc, argv);
+  // `articula <command> ...` parses exactly as `articula-<command> ...` does
+  // (CLI11 reads --config files on the root app only, so each command gets its own).
+  if (argc >= 2) {
+    for (auto& command : commands)
+      if (command->name() == argv[1])
+        return runSingle(argc - 1, argv + 1, std::string("articula ") + argv[1], std::move(command));
+  }
   CLI::App app{"articula: shape analysis of spheroidal joints from CT, and exact contact detection "
                "between smooth convex surfaces. Coordinates are LPS millimetres."};
   app.name("articula");
@@ -123,27 +137,11 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
   app.set_version_flag("--version", versionString());
   app.footer("Run 'articula <command> --help' for a command's options.\n"
              "Exit codes: 0 success, 1 processing failed, 2 usage error, 3 invalid input.");
-  std::vector<CommonOptions> common(commands.size());
-  std::vector<CLI::App*> subs;
-  for (size_t i = 0; i < commands.size(); ++i) {
-    CLI::App* sub = app.add_subcommand(commands[i]->name(), commands[i]->description());
-    describe(*sub, *commands[i]);
-    addCommonOptions(*sub, common[i]);
-    commands[i]->declare(*sub);
-    subs.push_back(sub);
-  }
+  for (const auto& command : commands) app.add_subcommand(command->name(), command->description());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return parseFailure(app, e);
-  }
-  for (size_t i = 0; i < commands.size(); ++i) {
-    if (subs[i]->parsed()) {
-      return guarded([&] {
-        applyCommon(common[i]);
-        return commands[i]->run(common[i]);
-      });
-    }
   }
   return static_cast<int>(ExitCode::UsageError);
 }

@@ -22,8 +22,9 @@ Eigen::Vector3d anglesFromRotation(const Eigen::Matrix3d& R) {
   const double theta = std::asin(s);
   if (std::fabs(s) > 1.0 - 1e-12) {
     // Gimbal lock: only phi +- psi is defined; put it all in phi.
+    // asin near +-1 loses half the digits; the exact angle is +-pi/2.
     const double phi = std::atan2(R(2, 1), R(1, 1));
-    return {phi, theta, 0.0};
+    return {phi, std::copysign(M_PI / 2, s), 0.0};
   }
   return {std::atan2(-R(1, 2), R(2, 2)), theta, std::atan2(-R(0, 1), R(0, 0))};
 }

@@ -1,0 +1,29 @@
+#pragma once
+// Internal: one reader per file family, and the checks they share.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "articula/points/point_io.hpp"
+
+namespace articula::points::detail {
+
+/// Hand-written PLY reader (see ply_reader.cpp for why not vtkPLYReader).
+PointCloud readPly(const std::filesystem::path& path);
+/// Delimited text: .csv, .xyz, .txt.
+PointCloud readTable(const std::filesystem::path& path);
+/// Vertices (and point normals, if any) of .stl, .obj, .vtp meshes through VTK.
+PointCloud readMeshVertices(const std::filesystem::path& path);
+
+/// Throws InputError unless every value is finite; scales normals to unit length and throws on a
+/// zero-length one. `where(i)` describes point i for the message, e.g. "line 12" or "vertex 3".
+void finishCloud(PointCloud& cloud, const std::filesystem::path& path,
+                 const std::function<std::string(Eigen::Index)>& where);
+
+/// `text` in lower case (ASCII), for extensions and header names.
+std::string lowercase(std::string text);
+
+/// 'path' in quotes, for messages.
+std::string quoted(const std::filesystem::path& path);
+
+}  // namespace articula::points::detail

@@ -1,0 +1,581 @@
+// Tests for lib/points: point-file reading and writing, and the fittability checks.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "articula/core/error.hpp"
+#include "articula/points/point_io.hpp"
+
+namespace fs = std::filesystem;
+using articula::InputError;
+using articula::UsageError;
+using articula::points::checkFittable;
+using articula::points::PointCloud;
+using articula::points::readPoints;
+using articula::points::writePoints;
+
+namespace {
+
+class PointsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("articula_points_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path file(const std::string& name) const { return dir_ / name; }
+
+  fs::path writeFile(const std::string& name, const std::string& bytes) const {
+    const fs::path path = file(name);
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+    return path;
+  }
+
+  fs::path dir_;
+};
+
+// The InputError message of readPoints(path); fails the test if anything else happens.
+std::string readError(const fs::path& path) {
+  try {
+    readPoints(path);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.code(), articula::ExitCode::InvalidInput);
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected InputError reading " << path << ", nothing thrown";
+  return {};
+}
+
+std::string fittableError(const PointCloud& cloud, int min_points) {
+  try {
+    checkFittable(cloud, min_points, "femoral head cap");
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("femoral head cap"), std::string::npos) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InputError from checkFittable";
+  return {};
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// A cloud with awkward doubles (not representable in float or short decimals) and unit normals.
+PointCloud awkwardCloud(bool with_normals) {
+  PointCloud cloud;
+  cloud.positions.resize(5, 3);
+  cloud.positions << 0.1, 1.0 / 3.0, -123.456789012345678,  //
+      1e-300, -2.5e7, std::nextafter(1.0, 2.0),             //
+      -0.0, 42.0, std::sqrt(2.0),                           //
+      M_PI, -M_E, 1e10 / 7.0,                               //
+      -17.25, 0.0, 5e-324;
+  if (with_normals) {
+    cloud.normals.resize(5, 3);
+    for (Eigen::Index i = 0; i < 5; ++i)
+      cloud.normals.row(i) = Eigen::RowVector3d(std::cos(0.3 * i), std::sin(0.7 * i), 0.2 + i).normalized();
+  }
+  return cloud;
+}
+
+void expectBitwiseEqual(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+  ASSERT_EQ(a.rows(), b.rows());
+  for (Eigen::Index i = 0; i < a.rows(); ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::memcmp(&a(i, k), &b(i, k), sizeof(double)), 0)
+          << "row " << i << " col " << k << ": " << a(i, k) << " vs " << b(i, k);
+}
+
+template <typename T>
+void appendBigEndian(std::string& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  const std::uint16_t one = 1;
+  if (*reinterpret_cast<const unsigned char*>(&one) == 1) std::reverse(bytes, bytes + sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+template <typename T>
+void appendLittleEndian(std::string& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  const std::uint16_t one = 1;
+  if (*reinterpret_cast<const unsigned char*>(&one) != 1) std::reverse(bytes, bytes + sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+fs::path sharedData() {
+  if (const char* env = std::getenv("ARTICULA_SHARED_DATA")) return env;
+  return ARTICULA_SHARED_DATA_DEFAULT;
+}
+
+// ---- round trips -------------------------------------------------------------------------------------
+
+TEST_F(PointsTest, PlyRoundTripIsBitExactWithAndWithoutNormals) {
+  for (bool with_normals : {true, false}) {
+    const PointCloud cloud = awkwardCloud(with_normals);
+    const fs::path path = file(with_normals ? "n.ply" : "p.ply");
+    writePoints(path, cloud);
+    const PointCloud back = readPoints(path);
+    expectBitwiseEqual(back.positions, cloud.positions);
+    EXPECT_EQ(back.normals.rows(), with_normals ? 5 : 0);
+    if (with_normals) expectBitwiseEqual(back.normals, cloud.normals);
+    // Header + 8-byte doubles per value, nothing more.
+    const auto values = static_cast<std::uintmax_t>(with_normals ? 30 : 15);
+    std::ifstream in(path, std::ios::binary);
+    std::string header, line;
+    while (std::getline(in, line) && line != "end_header") header += line + "\n";
+    EXPECT_EQ(fs::file_size(path), header.size() + std::string("end_header\n").size() + 8 * values);
+  }
+}
+
+TEST_F(PointsTest, CsvRoundTripIsExactWithAndWithoutNormals) {
+  for (bool with_normals : {true, false}) {
+    const PointCloud cloud = awkwardCloud(with_normals);
+    const fs::path path = file(with_normals ? "n.csv" : "p.csv");
+    writePoints(path, cloud);
+    std::ifstream in(path);
+    std::string header;
+    std::getline(in, header);
+    EXPECT_EQ(header, with_normals ? "x_mm,y_mm,z_mm,nx,ny,nz" : "x_mm,y_mm,z_mm");
+    const PointCloud back = readPoints(path);
+    expectBitwiseEqual(back.positions, cloud.positions);
+    EXPECT_EQ(back.normals.rows(), with_normals ? 5 : 0);
+    if (with_normals) expectBitwiseEqual(back.normals, cloud.normals);
+  }
+}
+
+TEST_F(PointsTest, PlyHeaderStatesFrameUnitsAndCallerComments) {
+  const fs::path path = file("c.ply");
+  writePoints(path, awkwardCloud(false), {"source LHDL_CT_femur_r.stl", "two\nlines"});
+  std::ifstream in(path, std::ios::binary);
+  std::string header, line;
+  while (std::getline(in, line) && line != "end_header") header += line + "\n";
+  EXPECT_TRUE(contains(header, "format binary_little_endian 1.0\n")) << header;
+  EXPECT_TRUE(contains(header, "comment coordinates LPS, units mm\n")) << header;
+  EXPECT_TRUE(contains(header, "comment source LHDL_CT_femur_r.stl\n")) << header;
+  EXPECT_TRUE(contains(header, "comment two lines\n")) << header;
+  EXPECT_TRUE(contains(header, "property double x\n")) << header;
+  EXPECT_EQ(readPoints(path).positions.rows(), 5);
+}
+
+TEST_F(PointsTest, WriteRefusesToOverwriteWhenAskedAndRejectsUnknownExtensions) {
+  const fs::path path = file("keep.csv");
+  writePoints(path, awkwardCloud(false));
+  const auto size = fs::file_size(path);
+  PointCloud other;
+  other.positions = Eigen::MatrixX3d::Ones(2, 3);
+  EXPECT_THROW(writePoints(path, other, {}, false), UsageError);
+  EXPECT_EQ(fs::file_size(path), size);
+  EXPECT_EQ(readPoints(path).positions.rows(), 5);
+  writePoints(path, other, {}, true);
+  EXPECT_EQ(readPoints(path).positions.rows(), 2);
+
+  EXPECT_THROW(writePoints(file("points.vtk"), other), UsageError);
+  EXPECT_FALSE(fs::exists(file("points.vtk")));
+  // No temporary files left behind.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+// ---- PLY written by hand -------------------------------------------------------------------------------
+
+TEST_F(PointsTest, ReadsAsciiPlyWithFloatsExtraPropertiesFacesAndCrlf) {
+  const std::string text =
+      "ply\r\n"
+      "format ascii 1.0\r\n"
+      "comment made by hand\r\n"
+      "element vertex 3\r\n"
+      "property float x\r\n"
+      "property float y\r\n"
+      "property float z\r\n"
+      "property float nx\r\n"
+      "property float ny\r\n"
+      "property float nz\r\n"
+      "property uchar red\r\n"
+      "element face 1\r\n"
+      "property list uchar int vertex_indices\r\n"
+      "end_header\r\n"
+      "1.5 -2.25 3 0 0 2 255\r\n"
+      "\r\n"
+      "4e1 5.0 -6.125 0 3 4 0\r\n"
+      "7 8 9 1 0 0 12\r\n"
+      "3 0 1 2\r\n";
+  const PointCloud cloud = readPoints(writeFile("hand.ply", text));
+  Eigen::MatrixX3d positions(3, 3), normals(3, 3);
+  positions << 1.5, -2.25, 3, 40, 5, -6.125, 7, 8, 9;
+  normals << 0, 0, 1, 0, 0.6, 0.8, 1, 0, 0;  // scaled to unit length
+  EXPECT_EQ(cloud.positions, positions);
+  ASSERT_EQ(cloud.normals.rows(), 3);
+  EXPECT_LT((cloud.normals - normals).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+TEST_F(PointsTest, ReadsBinaryBigEndianPlyWithMixedTypesAndAnElementBeforeTheVertices) {
+  std::string bytes =
+      "ply\n"
+      "format binary_big_endian 1.0\n"
+      "element material 2\n"
+      "property list uchar int ids\n"
+      "property float shininess\n"
+      "element vertex 2\n"
+      "property float x\n"
+      "property double y\n"
+      "property int z\n"
+      "property uchar quality\n"
+      "property double nx\n"
+      "property double ny\n"
+      "property double nz\n"
+      "element face 1\n"
+      "property list uchar int vertex_indices\n"
+      "end_header\n";
+  // Two materials with lists of 3 and 0 ids.
+  bytes += char(3);
+  for (std::int32_t id : {7, 8, 9}) appendBigEndian(bytes, id);
+  appendBigEndian(bytes, 0.5f);
+  bytes += char(0);
+  appendBigEndian(bytes, 0.25f);
+  // Vertices.
+  appendBigEndian(bytes, 1.25f);
+  appendBigEndian(bytes, 0.1);
+  appendBigEndian(bytes, std::int32_t{-300});
+  bytes += char(200);
+  appendBigEndian(bytes, 0.0);
+  appendBigEndian(bytes, 1.0);
+  appendBigEndian(bytes, 0.0);
+  appendBigEndian(bytes, -3.5f);
+  appendBigEndian(bytes, 1.0 / 3.0);
+  appendBigEndian(bytes, std::int32_t{70000});
+  bytes += char(1);
+  appendBigEndian(bytes, 0.6);
+  appendBigEndian(bytes, 0.0);
+  appendBigEndian(bytes, -0.8);
+  // A face that we do not need.
+  bytes += char(2);
+  appendBigEndian(bytes, std::int32_t{0});
+  appendBigEndian(bytes, std::int32_t{1});
+
+  const PointCloud cloud = readPoints(writeFile("be.ply", bytes));
+  ASSERT_EQ(cloud.positions.rows(), 2);
+  EXPECT_EQ(cloud.positions(0, 0), 1.25);
+  EXPECT_EQ(cloud.positions(0, 1), 0.1);  // exact double
+  EXPECT_EQ(cloud.positions(0, 2), -300.0);
+  EXPECT_EQ(cloud.positions(1, 0), -3.5);
+  EXPECT_EQ(cloud.positions(1, 1), 1.0 / 3.0);
+  EXPECT_EQ(cloud.positions(1, 2), 70000.0);
+  ASSERT_EQ(cloud.normals.rows(), 2);
+  EXPECT_EQ(cloud.normals.row(0), Eigen::RowVector3d(0, 1, 0));
+  EXPECT_LT((cloud.normals.row(1) - Eigen::RowVector3d(0.6, 0, -0.8)).norm(), 1e-15);
+}
+
+TEST_F(PointsTest, ReadsBinaryLittleEndianPlyOfFloatsWithoutNormals) {
+  std::string bytes =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  for (float v : {1.0f, 2.0f, 3.0f, -0.5f, 1e-3f, 1e6f}) appendLittleEndian(bytes, v);
+  const PointCloud cloud = readPoints(writeFile("le.PLY", bytes));
+  ASSERT_EQ(cloud.positions.rows(), 2);
+  EXPECT_EQ(cloud.normals.rows(), 0);
+  EXPECT_EQ(cloud.positions.row(1), Eigen::RowVector3d(-0.5, double(1e-3f), 1e6));
+}
+
+// ---- delimited text ---------------------------------------------------------------------------------------
+
+TEST_F(PointsTest, ReadsTextWithAndWithoutHeaderAndEverySeparator) {
+  Eigen::MatrixX3d expected(2, 3);
+  expected << 1.5, -2, 3e2, 4, 5.25, -6;
+  const std::pair<const char*, const char*> cases[] = {
+      {"comma.csv", "x,y,z\n1.5,-2,3e2\n4,5.25,-6\n"},
+      {"comma_spaces.csv", "x, y, z\r\n1.5, -2, 3e2\r\n4, 5.25, -6\r\n"},
+      {"no_header.csv", "1.5,-2,3e2\n4,5.25,-6\n"},
+      {"semicolon.csv", "X;Y;Z\n1.5;-2;3e2\n\n4;5.25;-6\n"},
+      {"tab.txt", "1.5\t-2\t3e2\n4\t5.25\t-6\n"},
+      {"space.xyz", "# exported by hand\n  1.5  -2 3e2\n4 5.25   -6  \n"},
+      {"named_columns.csv", "id,z_mm,y_mm,x_mm,quality\n0,3e2,-2,1.5,9\n1,-6,5.25,4,9\n"},
+  };
+  for (const auto& [name, text] : cases) {
+    const PointCloud cloud = readPoints(writeFile(name, text));
+    EXPECT_EQ(cloud.positions, expected) << name;
+    EXPECT_EQ(cloud.normals.rows(), 0) << name;
+  }
+}
+
+TEST_F(PointsTest, ReadsTextNormalsPositionallyOrByName) {
+  for (const auto& [name, text] :
+       {std::pair<const char*, const char*>{"six.csv", "1,2,3,0,0,-5\n4,5,6,0,1,0\n"},
+        std::pair<const char*, const char*>{"named.csv", "nz,ny,nx,x,y,z\n-5,0,0,1,2,3\n0,1,0,4,5,6\n"}}) {
+    const PointCloud cloud = readPoints(writeFile(name, text));
+    ASSERT_EQ(cloud.normals.rows(), 2) << name;
+    EXPECT_EQ(cloud.positions.row(1), Eigen::RowVector3d(4, 5, 6)) << name;
+    EXPECT_EQ(cloud.normals.row(0), Eigen::RowVector3d(0, 0, -1)) << name;
+    EXPECT_EQ(cloud.normals.row(1), Eigen::RowVector3d(0, 1, 0)) << name;
+  }
+}
+
+// ---- errors -------------------------------------------------------------------------------------------
+
+TEST_F(PointsTest, MissingEmptyAndUnknownFilesAreInputErrors) {
+  std::string m = readError(file("absent.ply"));
+  EXPECT_TRUE(contains(m, "absent.ply") && contains(m, "not found")) << m;
+  m = readError(writeFile("empty.csv", ""));
+  EXPECT_TRUE(contains(m, "empty.csv") && contains(m, "empty")) << m;
+  m = readError(writeFile("points.pts", "1 2 3\n"));
+  EXPECT_TRUE(contains(m, "points.pts") && contains(m, ".pts") && contains(m, "expected extension")) << m;
+  m = readError(writeFile("blank.csv", "\n# only a comment\n\n"));
+  EXPECT_TRUE(contains(m, "blank.csv") && contains(m, "found none")) << m;
+  m = readError(writeFile("header_only.csv", "x,y,z\n"));
+  EXPECT_TRUE(contains(m, "header_only.csv") && contains(m, "found none")) << m;
+  m = readError(dir_);
+  EXPECT_TRUE(contains(m, "directory")) << m;
+}
+
+TEST_F(PointsTest, BadTextRowsNameTheLine) {
+  std::string m = readError(writeFile("word.csv", "x,y,z\n1,2,3\n4,5,6\n7,eight,9\n"));
+  EXPECT_TRUE(contains(m, "word.csv") && contains(m, "line 4") && contains(m, "'eight'")) << m;
+  m = readError(writeFile("nan.csv", "1,2,3\n\n4,nan,6\n"));
+  EXPECT_TRUE(contains(m, "nan.csv") && contains(m, "line 3") && contains(m, "NaN or Inf")) << m;
+  m = readError(writeFile("inf.xyz", "1 2 3\n4 5 -inf\n"));
+  EXPECT_TRUE(contains(m, "line 2") && contains(m, "NaN or Inf")) << m;
+  m = readError(writeFile("short.csv", "1,2,3\n4,5\n"));
+  EXPECT_TRUE(contains(m, "line 2") && contains(m, "expected 3 columns")) << m;
+  m = readError(writeFile("four.csv", "1,2,3,4\n"));
+  EXPECT_TRUE(contains(m, "line 1") && contains(m, "found 4")) << m;
+  m = readError(writeFile("decimal_comma.csv", "1,5;2,5;3,5\n"));
+  EXPECT_TRUE(contains(m, "line 1") && contains(m, "'1,5'")) << m;
+  m = readError(writeFile("late_header.csv", "1,2,3\nx,y,z\n"));
+  EXPECT_TRUE(contains(m, "line 2") && contains(m, "'x'")) << m;
+  m = readError(writeFile("empty_field.csv", "1,2,3\n1,,3\n"));
+  EXPECT_TRUE(contains(m, "line 2") && contains(m, "column 2")) << m;
+  m = readError(writeFile("zero_normal.csv", "1,2,3,0,0,1\n4,5,6,0,0,0\n"));
+  EXPECT_TRUE(contains(m, "line 2") && contains(m, "non-zero length")) << m;
+}
+
+TEST_F(PointsTest, BadPlyDataNamesTheLineOrVertex) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+      "property double z\nend_header\n";  // data starts on line 8
+  std::string m = readError(writeFile("word.ply", header + "1 2 3\n4 five 6\n7 8 9\n"));
+  EXPECT_TRUE(contains(m, "word.ply") && contains(m, "line 9") && contains(m, "'five'")) << m;
+  m = readError(writeFile("nan.ply", header + "1 2 3\n4 5 6\n7 8 NaN\n"));
+  EXPECT_TRUE(contains(m, "line 10") && contains(m, "NaN or Inf")) << m;
+  m = readError(writeFile("few.ply", header + "1 2 3\n4 5 6\n"));
+  EXPECT_TRUE(contains(m, "few.ply") && contains(m, "end of the file")) << m;
+  m = readError(writeFile("many.ply", header + "1 2 3 4\n"));
+  EXPECT_TRUE(contains(m, "line 8") && contains(m, "more values")) << m;
+
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\n"
+      "property double y\nproperty double z\nend_header\n";
+  std::string data;
+  for (double v : {1.0, 2.0, 3.0, 4.0, std::numeric_limits<double>::infinity(), 6.0, 7.0, 8.0, 9.0})
+    appendLittleEndian(data, v);
+  m = readError(writeFile("inf.ply", binary + data));
+  EXPECT_TRUE(contains(m, "inf.ply") && contains(m, "vertex 1") && contains(m, "NaN or Inf")) << m;
+  m = readError(writeFile("truncated.ply", binary + data.substr(0, data.size() - 4)));
+  EXPECT_TRUE(contains(m, "truncated.ply") && contains(m, "truncated")) << m;
+  m = readError(writeFile("huge.ply",
+                          "ply\nformat binary_little_endian 1.0\nelement vertex 99999999999\n"
+                          "property double x\nproperty double y\nproperty double z\nend_header\n" +
+                              data));
+  EXPECT_TRUE(contains(m, "99999999999")) << m;
+}
+
+TEST_F(PointsTest, MalformedPlyHeadersNameTheLine) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"solid x\nformat ascii 1.0\n", "line 1"},
+      {"ply\nformat ascii 2.0\nelement vertex 1\nend_header\n", "line 2"},
+      {"ply\nformat utf8 1.0\n", "line 2"},
+      {"ply\nformat ascii 1.0\nproperty float x\n", "line 3"},
+      {"ply\nformat ascii 1.0\nelement vertex -4\n", "line 3"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty real x\n", "line 4"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n1 2 3\n",
+       "line 7"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n",
+       "end of the file"},
+      {"ply\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n",
+       "'format'"},
+      {"ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n3 0 1 2\n",
+       "element vertex"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n",
+       "x, y and z"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+       "property float nx\nend_header\n1 2 3 1\n",
+       "nx, ny, nz"},
+  };
+  int i = 0;
+  for (const auto& [text, where] : cases) {
+    const std::string name = "bad" + std::to_string(i++) + ".ply";
+    const std::string m = readError(writeFile(name, text));
+    EXPECT_TRUE(contains(m, name) && contains(m, where)) << "case " << name << ": " << m;
+  }
+}
+
+// ---- meshes through VTK --------------------------------------------------------------------------------
+
+TEST_F(PointsTest, ReadsBinaryStlVerticesMergedOnce) {
+  // Two triangles sharing an edge: 6 corners, 4 distinct vertices.
+  std::string bytes(80, ' ');
+  appendLittleEndian(bytes, std::uint32_t{2});
+  const float triangles[2][3][3] = {{{0, 0, 0}, {10, 0, 0}, {0, 10, 0}}, {{10, 0, 0}, {10, 10, 5}, {0, 10, 0}}};
+  for (const auto& triangle : triangles) {
+    for (int k = 0; k < 3; ++k) appendLittleEndian(bytes, 0.0f);  // facet normal (ignored)
+    for (const auto& corner : triangle)
+      for (float v : corner) appendLittleEndian(bytes, v);
+    bytes += std::string(2, '\0');
+  }
+  const PointCloud cloud = readPoints(writeFile("quad.stl", bytes));
+  ASSERT_EQ(cloud.positions.rows(), 4);
+  EXPECT_EQ(cloud.normals.rows(), 0);
+  EXPECT_EQ(cloud.positions.colwise().maxCoeff(), Eigen::RowVector3d(10, 10, 5));
+  EXPECT_EQ(cloud.positions.colwise().sum(), Eigen::RowVector3d(20, 20, 5));
+
+  const PointCloud ascii =
+      readPoints(writeFile("tri.stl",
+                           "solid tri\n facet normal 0 0 1\n  outer loop\n   vertex 1 2 3\n   vertex 4 5 6.5\n"
+                           "   vertex 7 8 9\n  endloop\n endfacet\nendsolid tri\n"));
+  ASSERT_EQ(ascii.positions.rows(), 3);
+  EXPECT_EQ(ascii.positions.row(1), Eigen::RowVector3d(4, 5, 6.5));
+}
+
+TEST_F(PointsTest, ReadsObjVerticesAndNormals) {
+  const std::string text =
+      "# tetrahedron\n"
+      "v 0 0 0\nv 1 0 0\nv 0 2 0\nv 0 0 3\n"
+      "vn 0 0 -1\nvn 0 0 -1\nvn 0 0 -1\nvn 0 0 1\n"
+      "f 1//1 3//3 2//2\nf 1//1 2//2 4//4\nf 1//1 4//4 3//3\nf 2//2 3//3 4//4\n";
+  const PointCloud cloud = readPoints(writeFile("tet.obj", text));
+  ASSERT_EQ(cloud.positions.rows(), 4);
+  ASSERT_EQ(cloud.normals.rows(), 4);
+  EXPECT_EQ(cloud.positions.row(3), Eigen::RowVector3d(0, 0, 3));
+  EXPECT_EQ(cloud.normals.row(3), Eigen::RowVector3d(0, 0, 1));
+  EXPECT_EQ(cloud.normals.row(0), Eigen::RowVector3d(0, 0, -1));
+
+  const PointCloud no_normals = readPoints(writeFile("tri.obj", "v 1 2 3\nv 4 5 6\nv 7 8 10\nf 1 2 3\n"));
+  EXPECT_EQ(no_normals.positions.rows(), 3);
+  EXPECT_EQ(no_normals.normals.rows(), 0);
+}
+
+TEST_F(PointsTest, ReadsVtpVerticesAndNormalsAndRejectsBrokenXml) {
+  const std::string text = R"(<?xml version="1.0"?>
+<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">
+  <PolyData>
+    <Piece NumberOfPoints="3" NumberOfVerts="0" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="1">
+      <PointData Normals="Normals">
+        <DataArray type="Float64" Name="Normals" NumberOfComponents="3" format="ascii">0 0 2 0 0 1 0 0 1</DataArray>
+      </PointData>
+      <Points>
+        <DataArray type="Float64" NumberOfComponents="3" format="ascii">0.1 0.2 0.3 10 0 0 0 10 0</DataArray>
+      </Points>
+      <Polys>
+        <DataArray type="Int64" Name="connectivity" format="ascii">0 1 2</DataArray>
+        <DataArray type="Int64" Name="offsets" format="ascii">3</DataArray>
+      </Polys>
+    </Piece>
+  </PolyData>
+</VTKFile>
+)";
+  const PointCloud cloud = readPoints(writeFile("tri.vtp", text));
+  ASSERT_EQ(cloud.positions.rows(), 3);
+  EXPECT_EQ(cloud.positions.row(0), Eigen::RowVector3d(0.1, 0.2, 0.3));  // Float64 kept exactly
+  ASSERT_EQ(cloud.normals.rows(), 3);
+  EXPECT_EQ(cloud.normals.row(0), Eigen::RowVector3d(0, 0, 1));
+
+  const std::string m = readError(writeFile("broken.vtp", text.substr(0, text.size() / 2)));
+  EXPECT_TRUE(contains(m, "broken.vtp")) << m;
+}
+
+TEST_F(PointsTest, GarbageMeshesAreInputErrors) {
+  for (const char* name : {"garbage.stl", "garbage.obj", "garbage.vtp"}) {
+    const std::string m = readError(writeFile(name, "this is not a mesh\n"));
+    EXPECT_TRUE(contains(m, name)) << m;
+  }
+  std::string truncated(80, ' ');
+  appendLittleEndian(truncated, std::uint32_t{1000});
+  truncated += std::string(100, '\0');
+  const std::string m = readError(writeFile("truncated.stl", truncated));
+  EXPECT_TRUE(contains(m, "truncated.stl")) << m;
+}
+
+TEST_F(PointsTest, ReadsTheRealFemurMesh) {
+  const fs::path path = sharedData() / "meshes/femur/LHDL_CT_femur_r.stl";
+  if (!fs::exists(path)) GTEST_SKIP() << "real data absent: " << path;
+  const PointCloud cloud = readPoints(path);
+  EXPECT_GT(cloud.positions.rows(), 30000);
+  EXPECT_EQ(cloud.normals.rows(), 0);
+  const Eigen::RowVector3d extent = cloud.positions.colwise().maxCoeff() - cloud.positions.colwise().minCoeff();
+  // An adult femur in millimetres: 35-55 cm long, a few centimetres across.
+  EXPECT_GT(extent.maxCoeff(), 350.0) << extent;
+  EXPECT_LT(extent.maxCoeff(), 550.0) << extent;
+  EXPECT_GT(extent.minCoeff(), 30.0) << extent;
+  EXPECT_LT(extent.minCoeff(), 150.0) << extent;
+  EXPECT_NO_THROW(checkFittable(cloud, 15, "femur"));
+  std::cout << "femur: " << cloud.positions.rows() << " vertices, extent " << extent << " mm\n";
+}
+
+// ---- fittability ---------------------------------------------------------------------------------------
+
+PointCloud posed(const Eigen::MatrixX3d& local) {
+  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(-1.1, Eigen::Vector3d(1, 2, 3).normalized()))
+                                       .toRotationMatrix();
+  PointCloud cloud;
+  cloud.positions = (local * rotation.transpose()).rowwise() + Eigen::RowVector3d(-120.5, 88.25, 310.0);
+  return cloud;
+}
+
+TEST(CheckFittable, AcceptsASphereCap) {
+  Eigen::MatrixX3d local(40, 3);
+  for (int i = 0; i < 40; ++i) {
+    const double polar = 0.9 * (i % 8) / 8.0, azimuth = 2 * M_PI * (i / 8) / 5.0;
+    local.row(i) << 22 * std::sin(polar) * std::cos(azimuth), 22 * std::sin(polar) * std::sin(azimuth),
+        22 * std::cos(polar);
+  }
+  EXPECT_NO_THROW(checkFittable(posed(local), 15, "cap"));
+  const std::string m = fittableError(posed(local), 41);
+  EXPECT_TRUE(contains(m, "at least 41") && contains(m, "found 40")) << m;
+}
+
+TEST(CheckFittable, RejectsNonFiniteDuplicateCollinearAndCoplanarClouds) {
+  Eigen::MatrixX3d local = Eigen::MatrixX3d::Random(30, 3) * 10.0;
+  PointCloud bad = posed(local);
+  bad.positions(17, 1) = std::numeric_limits<double>::quiet_NaN();
+  std::string m = fittableError(bad, 10);
+  EXPECT_TRUE(contains(m, "point 17")) << m;
+
+  PointCloud same;
+  same.positions = Eigen::RowVector3d(-120.5, 88.25, 310.1).replicate(30, 1);
+  m = fittableError(same, 10);
+  EXPECT_TRUE(contains(m, "duplicates")) << m;
+
+  Eigen::MatrixX3d line = Eigen::MatrixX3d::Zero(30, 3);
+  line.col(0) = Eigen::VectorXd::LinSpaced(30, -15.0, 15.0);
+  m = fittableError(posed(line), 10);
+  EXPECT_TRUE(contains(m, "collinear")) << m;
+
+  Eigen::MatrixX3d plane = local;
+  plane.col(2).setZero();
+  m = fittableError(posed(plane), 10);
+  EXPECT_TRUE(contains(m, "coplanar")) << m;
+
+  // A thin but genuinely curved cap (sagitta 0.05 mm over 20 mm) is accepted.
+  Eigen::MatrixX3d shallow = plane;
+  for (Eigen::Index i = 0; i < shallow.rows(); ++i) shallow(i, 2) = 0.05 * (shallow.row(i).squaredNorm() / 200.0);
+  EXPECT_NO_THROW(checkFittable(posed(shallow), 10, "shallow cap"));
+}
+
+}  // namespace
