@@ -180,22 +180,18 @@ ccd_t ccdSetup() {
   ccd.max_iterations = 1000;
   return ccd;
 }
-void BM_LibccdGjkEpa(benchmark::State& state) {
+using CcdPenetration = int (*)(const void*, const void*, const ccd_t*, ccd_real_t*, ccd_vec3_t*, ccd_vec3_t*);
+template <CcdPenetration Penetration>
+void BM_Libccd(benchmark::State& state) {
   const ccd_t ccd = ccdSetup();
   runMethod(state, [&](const Pair& p) -> double {
     ccd_real_t depth;
     ccd_vec3_t dir, pos;
-    return ccdGJKPenetration(&p.a, &p.b, &ccd, &depth, &dir, &pos) == 0 ? -static_cast<double>(depth) : NAN;
+    return Penetration(&p.a, &p.b, &ccd, &depth, &dir, &pos) == 0 ? -static_cast<double>(depth) : NAN;
   });
 }
-void BM_LibccdMpr(benchmark::State& state) {
-  const ccd_t ccd = ccdSetup();
-  runMethod(state, [&](const Pair& p) -> double {
-    ccd_real_t depth;
-    ccd_vec3_t dir, pos;
-    return ccdMPRPenetration(&p.a, &p.b, &ccd, &depth, &dir, &pos) == 0 ? -static_cast<double>(depth) : NAN;
-  });
-}
+void BM_LibccdGjkEpa(benchmark::State& state) { BM_Libccd<ccdGJKPenetration>(state); }
+void BM_LibccdMpr(benchmark::State& state) { BM_Libccd<ccdMPRPenetration>(state); }
 
 void classes(benchmark::internal::Benchmark* b) {
   for (int aspect : {0, 1})
