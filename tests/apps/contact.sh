@@ -42,3 +42,18 @@ grep -q '"converged_steps": 200' "$ARTICULA_TMP/motion.json"
 [ "$(wc -l < "$ARTICULA_TMP/motion.csv")" -eq 201 ]
 awk -F'[:,]' '/iterations_per_warm_step/ { exit !($2 < 8) }' "$ARTICULA_TMP/motion.json"
 echo "contact app: OK"
+
+# Two fitted surfaces: the head ellipsoid (rotated 90 deg about z: extent 22 mm
+# along x) at x = 10 and the superellipsoid (exponent 4, radius 25) at x = 70,
+# moved -5 mm by --pose-b: gap (65 - 25) - (10 + 22) = 8 mm.
+"$bin" contact --fits-a "$ARTICULA_SOURCE/testdata/contact/head_fits.json" \
+  --fits-b "$ARTICULA_SOURCE/testdata/contact/cup_fits.json" --pose-b -5,0,0,0,0,0 \
+  -o "$ARTICULA_TMP/fits.csv" --force -q
+awk -F, 'NR == 2 { d = $1 - 8; if (d < 0) d = -d; exit !(d < 1e-9 && $12 == "converged") }' "$ARTICULA_TMP/fits.csv"
+set +e
+"$bin" contact --fits-a "$ARTICULA_SOURCE/testdata/contact/head_fits.json" \
+  --fits-b "$ARTICULA_SOURCE/testdata/contact/cup_fits.json" --model-b superovoid -o "$ARTICULA_TMP/ovoid.csv" --force -q
+rc=$?
+set -e
+[ "$rc" -eq 2 ] || { echo "superovoid: expected usage error 2, got $rc"; exit 1; }
+echo "contact fits: OK"

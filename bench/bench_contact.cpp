@@ -1,0 +1,246 @@
+// bench-contact: minimum signed distance between random ellipsoid pairs
+// (uniform random orientations; semi-axes 0.5-1.5, and a set with aspect up
+// to 10: 0.15-1.5), 2,000 pairs per class:
+//   separated: reference distance > 0 (placed with a gap of 0.01-1 mm along a random direction),
+//   shallow:   penetration depth 0-0.05 mm (reference in [-0.05, 0)),
+//   deep:      penetration depth > 0.05 mm (placed with an overlap of 0.1-1 mm along a random direction).
+// Pairs are drawn and kept when the reference lands in the class.
+// Reference: the long-double support-function dual (contact/reference.hpp).
+// Each benchmark iteration is one query, cycling through the class's pairs.
+// Counters: median_ns (median over pairs of the fastest of 3 timed calls),
+// max_err / p99_err (mm, against the reference), failures (error > 1e-3 or
+// no answer), answered (pairs the method gave a distance for).
+// Peers: Simbody's ContactTracker::ConvexImplicitPair (the same six equations,
+// reports overlap only), libccd GJK+EPA and MPR (penetration only; an exact
+// ellipsoid support function).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <Simbody.h>
+#include <benchmark/benchmark.h>
+#include <ccd/ccd.h>
+
+#include "articula/contact/common_normal.hpp"
+#include "articula/contact/plane_contact.hpp"
+#include "articula/contact/reference.hpp"
+
+namespace {
+
+using namespace articula::contact;
+using Eigen::Vector3d;
+
+constexpr int kPairs = 2000;
+const char* kClassNames[3] = {"separated", "shallow", "deep"};
+
+struct Pair {
+  ConvexShape a, b;
+  double reference;
+  ContactResult previous;  // solution one small motion step earlier (warm start)
+};
+
+std::vector<Pair> makePairs(int cls, int aspect) {
+  std::mt19937_64 rng(1000 + 10 * cls + aspect);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> radius(aspect ? 0.15 : 0.5, 1.5);
+  const double lo[3] = {0.01, -0.1, -1.0}, hi[3] = {1.0, 0.0, -0.1};
+  std::uniform_real_distribution<double> gap(lo[cls], hi[cls]);
+  auto shape = [&] {
+    return makeConvexShape(Vector3d::Zero(),
+                           Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix(),
+                           Vector3d(radius(rng), radius(rng), radius(rng)));
+  };
+  std::vector<Pair> pairs;
+  while (static_cast<int>(pairs.size()) < kPairs) {
+    Pair p{shape(), shape(), 0.0, {}};
+    const Vector3d dir = Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const double ea = dir.dot(toGlobal(p.a, supportCanonical(p.a, dir)));
+    const double eb = -dir.dot(toGlobal(p.b, supportCanonical(p.b, -dir)));
+    p.b.center = dir * (ea + eb + gap(rng));
+    p.reference = referenceEllipsoidDistance(p.a, p.b, 1500, 4);
+    const bool in_class = cls == 0 ? p.reference > 0.0 : cls == 1 ? p.reference >= -0.05 && p.reference < 0.0
+                                                                  : p.reference < -0.05;
+    if (!in_class) continue;
+    // One step earlier: b 0.01 mm and 0.01 rad away.
+    ConvexShape before = p.b;
+    before.center += 0.01 * Vector3d(g(rng), g(rng), g(rng)).normalized();
+    before.rotation = Eigen::AngleAxisd(0.01, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+    p.previous = computeContact(p.a, before);
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
+const std::vector<Pair>& pairSet(int cls, int aspect) {
+  static std::vector<Pair> sets[3][2];
+  if (sets[cls][aspect].empty()) sets[cls][aspect] = makePairs(cls, aspect);
+  return sets[cls][aspect];
+}
+
+// A method answers a pair with a signed distance, or NaN for "no answer".
+using Method = std::function<double(const Pair&)>;
+
+void accuracyCounters(benchmark::State& state, const std::vector<Pair>& pairs, const Method& method) {
+  std::vector<double> errors, times;
+  int failures = 0, answered = 0;
+  for (const Pair& p : pairs) {
+    double d = NAN, best = INFINITY;
+    for (int r = 0; r < 3; ++r) {
+      const auto t0 = std::chrono::steady_clock::now();
+      d = method(p);
+      best = std::min(best, std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
+    }
+    times.push_back(best);
+    if (!std::isfinite(d)) {
+      ++failures;
+      continue;
+    }
+    ++answered;
+    const double e = std::fabs(d - p.reference);
+    errors.push_back(e);
+    failures += e > 1e-3;
+  }
+  std::sort(times.begin(), times.end());
+  std::sort(errors.begin(), errors.end());
+  state.counters["median_ns"] = times[times.size() / 2];
+  state.counters["max_err"] = errors.empty() ? NAN : errors.back();
+  state.counters["p99_err"] = errors.empty() ? NAN : errors[errors.size() * 99 / 100];
+  state.counters["failures"] = failures;
+  state.counters["answered"] = answered;
+}
+
+void runMethod(benchmark::State& state, const Method& method) {
+  const auto& pairs = pairSet(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  state.SetLabel(std::string(kClassNames[state.range(0)]) + (state.range(1) ? ", aspect<=10" : ", axes 0.5-1.5"));
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(method(pairs[i]));
+    if (++i == pairs.size()) i = 0;
+  }
+  accuracyCounters(state, pairs, method);
+}
+
+// ---------------------------------------------------------------- ours
+void BM_OursCold(benchmark::State& state) {
+  runMethod(state, [](const Pair& p) { return computeContact(p.a, p.b).distance; });
+}
+void BM_OursWarm(benchmark::State& state) {
+  runMethod(state, [](const Pair& p) { return computeContact(p.a, p.b, {}, &p.previous).distance; });
+}
+
+// ---------------------------------------------------------------- Simbody
+SimTK::Transform simbodyTransform(const ConvexShape& s) {
+  SimTK::Mat33 R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = s.rotation(r, c);
+  return SimTK::Transform(SimTK::Rotation(R, true), SimTK::Vec3(s.center[0], s.center[1], s.center[2]));
+}
+void BM_Simbody(benchmark::State& state) {
+  const SimTK::ContactTracker::ConvexImplicitPair tracker(SimTK::ContactGeometry::Ellipsoid::classTypeId(),
+                                                          SimTK::ContactGeometry::Ellipsoid::classTypeId());
+  runMethod(state, [&](const Pair& p) -> double {
+    const SimTK::ContactGeometry::Ellipsoid ea(SimTK::Vec3(p.a.radii[0], p.a.radii[1], p.a.radii[2]));
+    const SimTK::ContactGeometry::Ellipsoid eb(SimTK::Vec3(p.b.radii[0], p.b.radii[1], p.b.radii[2]));
+    SimTK::Contact current;
+    const SimTK::UntrackedContact prior{SimTK::ContactSurfaceIndex(0), SimTK::ContactSurfaceIndex(1)};
+    if (!tracker.trackContact(prior, simbodyTransform(p.a), ea, simbodyTransform(p.b), eb, SimTK::Infinity, current))
+      return NAN;
+    if (current.isEmpty()) return NAN;  // separated: no contact reported
+    if (SimTK::PointContact::isInstance(current))
+      return -static_cast<const SimTK::PointContact&>(current).getDepth();
+    if (SimTK::CircularPointContact::isInstance(current))
+      return -SimTK::CircularPointContact::getAs(current).getDepth();
+    if (SimTK::EllipticalPointContact::isInstance(current))
+      return -SimTK::EllipticalPointContact::getAs(current).getDepth();
+    return NAN;  // separated: Simbody reports no contact (and no distance)
+  });
+}
+
+// ---------------------------------------------------------------- libccd
+void ellipsoidSupport(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
+  const ConvexShape& s = *static_cast<const ConvexShape*>(obj);
+  const Vector3d v(dir->v[0], dir->v[1], dir->v[2]);
+  const Vector3d x = toGlobal(s, supportCanonical(s, v));
+  ccdVec3Set(out, x[0], x[1], x[2]);
+}
+void ellipsoidCenter(const void* obj, ccd_vec3_t* out) {
+  const ConvexShape& s = *static_cast<const ConvexShape*>(obj);
+  ccdVec3Set(out, s.center[0], s.center[1], s.center[2]);
+}
+ccd_t ccdSetup() {
+  ccd_t ccd;
+  CCD_INIT(&ccd);
+  ccd.support1 = ellipsoidSupport;
+  ccd.support2 = ellipsoidSupport;
+  ccd.center1 = ellipsoidCenter;
+  ccd.center2 = ellipsoidCenter;
+  ccd.max_iterations = 1000;
+  return ccd;
+}
+using CcdPenetration = int (*)(const void*, const void*, const ccd_t*, ccd_real_t*, ccd_vec3_t*, ccd_vec3_t*);
+template <CcdPenetration Penetration>
+void BM_Libccd(benchmark::State& state) {
+  const ccd_t ccd = ccdSetup();
+  runMethod(state, [&](const Pair& p) -> double {
+    ccd_real_t depth;
+    ccd_vec3_t dir, pos;
+    return Penetration(&p.a, &p.b, &ccd, &depth, &dir, &pos) == 0 ? -static_cast<double>(depth) : NAN;
+  });
+}
+void BM_LibccdGjkEpa(benchmark::State& state) { BM_Libccd<ccdGJKPenetration>(state); }
+void BM_LibccdMpr(benchmark::State& state) { BM_Libccd<ccdMPRPenetration>(state); }
+
+// ---------------------------------------------------------------- superellipsoid-plane
+// Closed form (support mapping, 1-D root find for unequal exponents 2-4).
+// Counters: max |F| at the answer and max (1 - n_shape . (-n_plane)), i.e.
+// how exactly the point lies on the surface with the plane's normal.
+void BM_SuperellipsoidPlane(benchmark::State& state) {
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> radius(0.5, 1.5), exponent(2.0, 4.0);
+  struct Query {
+    ConvexShape s;
+    Vector3d p, n;
+  };
+  std::vector<Query> queries;
+  for (int i = 0; i < kPairs; ++i)
+    queries.push_back({makeConvexShape(Vector3d(g(rng), g(rng), g(rng)),
+                                       Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix(),
+                                       Vector3d(radius(rng), radius(rng), radius(rng)),
+                                       Vector3d(exponent(rng), exponent(rng), exponent(rng))),
+                       Vector3d(g(rng), g(rng), g(rng)), Vector3d(g(rng), g(rng), g(rng)).normalized()});
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(shapePlaneContact(queries[i].s, queries[i].p, queries[i].n).distance);
+    if (++i == queries.size()) i = 0;
+  }
+  double max_f = 0.0, max_angle = 0.0;
+  for (const Query& q : queries) {
+    const ContactResult r = shapePlaneContact(q.s, q.p, q.n);
+    const auto e = evaluateCanonical(q.s, toCanonical(q.s, r.point_a));
+    const Vector3d n = (q.s.rotation * e.gradient.cwiseQuotient(q.s.radii)).normalized();
+    max_f = std::max(max_f, std::fabs(e.value));
+    max_angle = std::max(max_angle, 1.0 - n.dot(-q.n));
+  }
+  state.counters["max_abs_F"] = max_f;
+  state.counters["max_1_minus_cos"] = max_angle;
+}
+BENCHMARK(BM_SuperellipsoidPlane);
+
+void classes(benchmark::internal::Benchmark* b) {
+  for (int aspect : {0, 1})
+    for (int cls : {0, 1, 2}) b->Args({cls, aspect});
+}
+BENCHMARK(BM_OursCold)->Apply(classes);
+BENCHMARK(BM_OursWarm)->Apply(classes);
+BENCHMARK(BM_Simbody)->Apply(classes);
+BENCHMARK(BM_LibccdGjkEpa)->Apply(classes);
+BENCHMARK(BM_LibccdMpr)->Apply(classes);
+
+}  // namespace
+
+BENCHMARK_MAIN();
