@@ -288,14 +288,24 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
                                " mm): the seed may not be in a joint head");
 
   // The surface at the surface level (nearer half maximum than the window's
-  // lower end, which sits a third of a voxel outside in partial volume):
-  // voxels near the label's boundary below that level leave the label.
+  // lower end, which sits a third of a voxel outside in partial volume).
   if (options.surface_hu > options.hu_min) {
-    const Image<float> distance = signedDistance(head);
-    const double shell = 2.0 * bg.spacing.maxCoeff();
-    for (size_t n = 0; n < head.voxels.size(); ++n)
-      if (head.voxels[n] && -distance.voxels[n] < shell && box_hu.voxels[n] < options.surface_hu) head.voxels[n] = 0;
-    head = fillHoles(head);
+    // Peel twice: only voxels on the label's outer layer, so the cortex keeps
+    // the darker cancellous interior inside.
+    for (int peel = 0; peel < 2; ++peel) {
+      Mask next = head;
+      for (int k = 0; k < bg.size[2]; ++k)
+        for (int j = 0; j < bg.size[1]; ++j)
+          for (int i = 0; i < bg.size[0]; ++i) {
+            if (!head.at(i, j, k) || box_hu.at(i, j, k) >= options.surface_hu) continue;
+            const bool outer = i == 0 || j == 0 || k == 0 || i + 1 == bg.size[0] || j + 1 == bg.size[1] ||
+                               k + 1 == bg.size[2] || !head.at(i - 1, j, k) || !head.at(i + 1, j, k) ||
+                               !head.at(i, j - 1, k) || !head.at(i, j + 1, k) || !head.at(i, j, k - 1) ||
+                               !head.at(i, j, k + 1);
+            if (outer) next.at(i, j, k) = 0;
+          }
+      head = next;
+    }
   }
 
   Label label;
