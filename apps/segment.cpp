@@ -34,6 +34,7 @@ class SegmentCommand : public cli::Command {
     app.add_option("--series-uid", series_uid_, "DICOM series to read when the folder holds several");
     app.add_option("--hu-min", options_.hu_min, "Lower end of the bone window (HU)")->capture_default_str();
     app.add_option("--hu-max", options_.hu_max, "Upper end of the bone window (HU)")->capture_default_str();
+    app.add_option("--surface-hu", options_.surface_hu, "Level of the head's final surface (HU)")->capture_default_str();
     app.add_option("--roi", roi_, "Box xmin,ymin,zmin,xmax,ymax,zmax in LPS mm")->delimiter(',')->expected(6);
     app.add_option("--min-radius", options_.min_head_radius_mm, "Smallest plausible head radius (mm)")->capture_default_str();
     app.add_option("--max-radius", options_.max_head_radius_mm, "Largest plausible head radius (mm)")->capture_default_str();
@@ -64,7 +65,7 @@ class SegmentCommand : public cli::Command {
     imaging::writeLabel(output_, label, true);
 
     nlohmann::json params = {{"joint", joint_}, {"side", side_}, {"hu_min", options_.hu_min},
-                             {"hu_max", options_.hu_max}, {"series_uid", series_uid_},
+                             {"hu_max", options_.hu_max}, {"surface_hu", options_.surface_hu}, {"series_uid", series_uid_},
                              {"min_radius_mm", options_.min_head_radius_mm},
                              {"max_radius_mm", options_.max_head_radius_mm}};
     if (options_.seed_point) params["seed_point_mm"] = vec(*options_.seed_point);

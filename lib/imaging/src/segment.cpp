@@ -225,8 +225,8 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   // partial volume lifts it into the HU window, the black top-hat (closing
   // minus image) finds it, and those voxels leave the bone mask.
   Mask box_raw = crop(mask, lo, hi);
+  const Volume box_hu = crop(volume, lo, hi);
   if (options.gap_contrast_hu > 0) {
-    const Volume box_hu = crop(volume, lo, hi);
     using FloatImage = itk::Image<float, 3>;
     using Ball = itk::FlatStructuringElement<3>;
     Ball::RadiusType radius;
@@ -239,7 +239,8 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     const Image<float> valley = fromItk<float>(tophat->GetOutput());
     long long removed = 0;
     for (size_t n = 0; n < box_raw.voxels.size(); ++n)
-      if (box_raw.voxels[n] && valley.voxels[n] > options.gap_contrast_hu) box_raw.voxels[n] = 0, ++removed;
+      if (box_raw.voxels[n] && valley.voxels[n] > options.gap_contrast_hu && box_hu.voxels[n] < options.surface_hu)
+        box_raw.voxels[n] = 0, ++removed;
     log::debug("joint-gap valley: " + std::to_string(removed) + " voxels removed from the bone mask");
   }
   const Mask box_mask = fillHoles(box_raw);
@@ -285,6 +286,27 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   if (best < 0.5 * options.min_head_radius_mm)
     summary.warnings.push_back("the labelled head is thin (depth " + std::to_string(best) +
                                " mm): the seed may not be in a joint head");
+
+  // The surface at the surface level (nearer half maximum than the window's
+  // lower end, which sits a third of a voxel outside in partial volume).
+  if (options.surface_hu > options.hu_min) {
+    // Peel twice: only voxels on the label's outer layer, so the cortex keeps
+    // the darker cancellous interior inside.
+    for (int peel = 0; peel < 2; ++peel) {
+      Mask next = head;
+      for (int k = 0; k < bg.size[2]; ++k)
+        for (int j = 0; j < bg.size[1]; ++j)
+          for (int i = 0; i < bg.size[0]; ++i) {
+            if (!head.at(i, j, k) || box_hu.at(i, j, k) >= options.surface_hu) continue;
+            const bool outer = i == 0 || j == 0 || k == 0 || i + 1 == bg.size[0] || j + 1 == bg.size[1] ||
+                               k + 1 == bg.size[2] || !head.at(i - 1, j, k) || !head.at(i + 1, j, k) ||
+                               !head.at(i, j - 1, k) || !head.at(i, j + 1, k) || !head.at(i, j, k - 1) ||
+                               !head.at(i, j, k + 1);
+            if (outer) next.at(i, j, k) = 0;
+          }
+      head = next;
+    }
+  }
 
   Label label;
   label.geometry = g;

@@ -29,6 +29,7 @@ struct SegmentOptions {
   double search_spacing_mm = 2.0;                   // grid of the automatic head search
   double gap_width_mm = 4.0;     // widest joint gap the valley filter closes
   double gap_contrast_hu = 300;  // black top-hat above which a voxel is gap, not bone (0: off)
+  double surface_hu = 400;       // level of the head's final surface (<= hu_min: the window's end)
   /// Throws UsageError naming the first invalid option.
   void validate() const;
 };

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Every bad input of the CT chain exits with the documented code and a clear message.
+set -uo pipefail
+B=$ARTICULA_BIN
+T=$ARTICULA_TMP
+rm -rf "$T" && mkdir -p "$T"
+fail=0
+expect() {  # expect CODE PATTERN -- command...
+  local code=$1 pattern=$2
+  shift 3
+  "$@" > "$T/out" 2> "$T/err"
+  local got=$?
+  if [[ $got != "$code" ]] || ! grep -qi -- "$pattern" "$T/err"; then
+    echo "FAIL: $* -> exit $got (expected $code), stderr:"; cat "$T/err"; fail=1
+  fi
+}
+mkdir -p "$T/empty" "$T/notdicom"
+echo "hello" > "$T/notdicom/readme.txt"
+expect 3 "empty folder" -- "$B/articula-segment" -i "$T/empty" -o "$T/l.nii.gz"
+expect 3 "no readable DICOM" -- "$B/articula-segment" -i "$T/notdicom" -o "$T/l.nii.gz"
+expect 3 "not found" -- "$B/articula-segment" -i "$T/missing.nii.gz" -o "$T/l.nii.gz"
+test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for bad input"; fail=1; }
+
+"$B/articula" phantom -o "$T/p" --seed 2 --spacing 1.5,1.5,2 -q
+# A missing slice: non-uniform spacing, named.
+cp -r "$T/p/dicom" "$T/gap"
+rm "$T/gap/slice_0020.dcm"
+expect 3 "non-uniform slice spacing" -- "$B/articula-segment" -i "$T/gap" -o "$T/l.nii.gz"
+# Two CT series in one folder: listed, --series-uid needed.
+"$B/articula" phantom -o "$T/q" --seed 3 --spacing 1.5,1.5,2 -q
+mkdir -p "$T/two" && cp "$T/p/dicom/"*.dcm "$T/two/" && for f in "$T/q/dicom/"*.dcm; do cp "$f" "$T/two/q_$(basename "$f")"; done
+expect 3 "several CT series" -- "$B/articula-segment" -i "$T/two" -o "$T/l.nii.gz"
+# An HU window with no voxel.
+expect 3 "no voxel in the HU window" -- "$B/articula-segment" -i "$T/p/phantom.nii.gz" -o "$T/l.nii.gz" --hu-min 5000 --hu-max 6000
+# No head on the left of a right hip phantom (with a radius range that excludes the trochanter).
+expect 1 "no femoral head found" -- "$B/articula-segment" -i "$T/p/phantom.nii.gz" -o "$T/l.nii.gz" --side left --min-radius 30
+# An empty label.
+"$B/articula-segment" -i "$T/p/phantom.nii.gz" -o "$T/head.nii.gz" -q
+python3 - "$T/empty.nii.gz" <<'PY'
+import gzip, struct, sys
+# A minimal NIfTI-1 label: 4x4x4 uint8 zeros, 1 mm voxels.
+h = bytearray(348)
+struct.pack_into("<i", h, 0, 348)
+struct.pack_into("<8h", h, 40, 3, 4, 4, 4, 1, 1, 1, 1)
+struct.pack_into("<hh", h, 70, 2, 8)
+struct.pack_into("<8f", h, 76, 1, 1, 1, 1, 0, 0, 0, 0)
+struct.pack_into("<f", h, 108, 352.0)
+struct.pack_into("<f", h, 112, 1.0)
+h[344:348] = b"n+1\0"
+gzip.open(sys.argv[1], "wb").write(bytes(h) + b"\0" * 4 + b"\0" * 64)
+PY
+expect 3 "no voxel set" -- "$B/articula-mesh" -i "$T/empty.nii.gz" -o "$T/m.stl"
+expect 2 "smooth-iterations" -- "$B/articula-mesh" -i "$T/head.nii.gz" -o "$T/m.vtp" --smooth-iterations -1
+# A mesh with no triangles, a too small selection, a bad --select.
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n' > "$T/points-only.ply"
+expect 3 "no triangles" -- "$B/articula-sample" -i "$T/points-only.ply" -o "$T/s.ply"
+"$B/articula-mesh" -i "$T/head.nii.gz" -o "$T/head.vtp" -q
+expect 3 "expected at least" -- "$B/articula-sample" -i "$T/head.vtp" -o "$T/s.ply" --select sphere:0,0,0,1
+expect 2 "expected auto" -- "$B/articula-sample" -i "$T/head.vtp" -o "$T/s.ply" --select blob
+exit $fail
