@@ -36,7 +36,7 @@ set +e
 "$bin/articula" batch "$tmp/study.csv" -o "$tmp/study" -j 2 2> "$tmp/batch.err"
 rc=$?
 set -e
-first=$(echo "$(date +%s.%N) - $start" | bc)
+first=$(python3 -c "print(round($(date +%s.%N) - $start, 2))")
 [ "$rc" -eq 1 ] || { cat "$tmp/batch.err" >&2; fail "batch with failing subjects exited $rc, expected 1"; }
 python3 - "$tmp/study" <<'PY'
 import csv, json, sys
@@ -70,7 +70,7 @@ start=$(date +%s.%N)
 set +e
 "$bin/articula" batch "$tmp/study.csv" -o "$tmp/study" -j 2 2> "$tmp/rerun.err"
 set -e
-second=$(echo "$(date +%s.%N) - $start" | bc)
+second=$(python3 -c "print(round($(date +%s.%N) - $start, 2))")
 grep -q "2 ok (2 from an earlier run)" "$tmp/rerun.err" || { cat "$tmp/rerun.err" >&2; fail "rerun did not resume"; }
 echo "batch: first run ${first}s, rerun ${second}s"
 
