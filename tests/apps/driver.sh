@@ -1,17 +1,7 @@
 #!/usr/bin/env bash
 # The driver's shared conventions: --version, exit codes 0/1/2/3, --config,
 # --force, --json, atomic outputs. Run by ctest as app_driver.
-set -euo pipefail
-bin=${ARTICULA_BIN:?}
-tmp=${ARTICULA_TMP:?}
-rm -rf "$tmp" && mkdir -p "$tmp"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_rc() {  # expect_rc CODE command...
-  local want=$1; shift
-  set +e; "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?; set -e
-  [ "$rc" -eq "$want" ] || { cat "$tmp/err" >&2; fail "'$*' exited $rc, expected $want"; }
-}
+source "$(dirname "$0")/common.bash"
 
 expect_rc 0 "$bin/articula" --version
 grep -q "articula 0\.[0-9]*\.[0-9]* (commit " "$tmp/out" || fail "--version prints version and commit"

@@ -1,17 +1,7 @@
 #!/usr/bin/env bash
 # articula-fit and articula-errors end to end on an exact synthetic superovoid
 # (from `articula surface`), and every bad input's exit code and message.
-set -euo pipefail
-bin=${ARTICULA_BIN:?}
-tmp=${ARTICULA_TMP:?}
-rm -rf "$tmp" && mkdir -p "$tmp"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_rc() {  # expect_rc CODE command...
-  local want=$1; shift
-  set +e; "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?; set -e
-  [ "$rc" -eq "$want" ] || { cat "$tmp/err" >&2; fail "'$*' exited $rc, expected $want"; }
-}
+source "$(dirname "$0")/common.bash"
 # csv_value FILE MODEL COLUMN: the value of COLUMN in the row of MODEL.
 csv_value() {
   awk -F, -v m="$2" -v c="$3" 'NR==1{for(i=1;i<=NF;i++) if($i==c) col=i; next} $1==m{print $col}' "$1"

@@ -4,14 +4,10 @@
 # joint surface and the bone side, about 1-2 mm apart), so RMS is about half
 # the thickness; the sphere radius must be an adult femoral head's (20-28 mm)
 # and RMS ordered as the hierarchy guarantees.
-set -euo pipefail
-bin=${ARTICULA_BIN:?}
-tmp=${ARTICULA_TMP:?}
+source "$(dirname "$0")/common.bash"
 data=${ARTICULA_SHARED_DATA:-}
 mesh="$data/meshes/femoral-head-cartilage/VHF_Left_Cartilage_FemurHead_smooth.stl"
 [ -f "$mesh" ] || { echo "skipped: $mesh not found"; exit 77; }
-rm -rf "$tmp" && mkdir -p "$tmp"
-fail() { echo "FAIL: $*" >&2; exit 1; }
 csv_value() {
   awk -F, -v m="$2" -v c="$3" 'NR==1{for(i=1;i<=NF;i++) if($i==c) col=i; next} $1==m{print $col}' "$1"
 }

@@ -4,12 +4,9 @@
 # patch), articula-fit fits the hierarchy. Expected (../shared/data/README.md):
 # sphere radius 20-28 mm (quick fits gave 22.6-23.0 mm), and the RMS ordered
 # sphere >= ellipsoid >= superellipsoid >= superovoid, ovoid >= superovoid.
-set -euo pipefail
-bin=${ARTICULA_BIN:?}
-tmp=${ARTICULA_TMP:?}
+source "$(dirname "$0")/common.bash"
 data=${ARTICULA_SHARED_DATA:?}/meshes/femur
 [ -d "$data" ] || { echo "no shared data at $data: skipped"; exit 77; }
-rm -rf "$tmp" && mkdir -p "$tmp"
 for femur in LHDL_CT_femur_r TLEM2_femur_r; do
   "$bin/articula-sample" -i "$data/$femur.stl" -o "$tmp/$femur.ply" --ball-radius 1 --quiet
   "$bin/articula-fit" -i "$tmp/$femur.ply" -o "$tmp/$femur.json" --quiet

@@ -3,12 +3,8 @@
 # exit 1, the good subjects complete and correct, failures listed with reasons;
 # a rerun resumes without redoing anything; Snakemake (local profile) gives
 # the same study.csv as articula batch; the same seed gives identical outputs.
-set -euo pipefail
-bin=${ARTICULA_BIN:?}
-tmp=${ARTICULA_TMP:?}
+source "$(dirname "$0")/common.bash"
 src=${ARTICULA_SOURCE:?}
-rm -rf "$tmp" && mkdir -p "$tmp"
-fail() { echo "FAIL: $*" >&2; exit 1; }
 
 "$bin/articula" phantom -o "$tmp/data/p1" --seed 3 --model ellipsoid --no-dicom --quiet
 "$bin/articula" phantom -o "$tmp/data/p2" --seed 5 --model sphere --quiet
