@@ -35,6 +35,12 @@ class SegmentCommand : public cli::Command {
     app.add_option("--hu-min", options_.hu_min, "Lower end of the bone window (HU)")->capture_default_str();
     app.add_option("--hu-max", options_.hu_max, "Upper end of the bone window (HU)")->capture_default_str();
     app.add_option("--surface-hu", options_.surface_hu, "Level of the head's final surface (HU)")->capture_default_str();
+    app.add_option("--close-radius", options_.close_radius_mm,
+                   "Closing radius before hole filling, mm (bridges speckled cancellous bone; 0: off)")->capture_default_str();
+    app.add_option("--midline-margin", options_.midline_margin_mm,
+                   "Least distance (mm) of an automatically found head from the volume's mid-sagittal plane")->capture_default_str();
+    app.add_option("--min-coverage", options_.min_coverage,
+                   "Least share (0-1) of an automatically found head's sphere that is bone surface")->capture_default_str();
     app.add_option("--roi", roi_, "Box xmin,ymin,zmin,xmax,ymax,zmax in LPS mm")->delimiter(',')->expected(6);
     app.add_option("--min-radius", options_.min_head_radius_mm, "Smallest plausible head radius (mm)")->capture_default_str();
     app.add_option("--max-radius", options_.max_head_radius_mm, "Largest plausible head radius (mm)")->capture_default_str();
@@ -67,7 +73,9 @@ class SegmentCommand : public cli::Command {
     nlohmann::json params = {{"joint", joint_}, {"side", side_}, {"hu_min", options_.hu_min},
                              {"hu_max", options_.hu_max}, {"surface_hu", options_.surface_hu}, {"series_uid", series_uid_},
                              {"min_radius_mm", options_.min_head_radius_mm},
-                             {"max_radius_mm", options_.max_head_radius_mm}};
+                             {"max_radius_mm", options_.max_head_radius_mm},
+                             {"close_radius_mm", options_.close_radius_mm}, {"min_coverage", options_.min_coverage},
+                             {"midline_margin_mm", options_.midline_margin_mm}};
     if (options_.seed_point) params["seed_point_mm"] = vec(*options_.seed_point);
     if (options_.roi_min) params["roi_mm"] = {vec(*options_.roi_min), vec(*options_.roi_max)};
     std::vector<std::filesystem::path> inputs;
@@ -92,6 +100,7 @@ class SegmentCommand : public cli::Command {
         {"seed_source", s.seed_source},
         {"seed_mm", vec(s.seed_mm)},
         {"head_center_mm", vec(s.head_center_mm)},
+        {"search_radius_mm", s.search_radius_mm},
         {"head_depth_mm", s.head_depth_mm},
         {"threshold_voxels", s.threshold_voxels},
         {"label_voxels", s.label_voxels},

@@ -6,7 +6,9 @@
 #include <sstream>
 
 #include <itkBinaryFillholeImageFilter.h>
+#include <itkBinaryMorphologicalClosingImageFilter.h>
 #include <itkBlackTopHatImageFilter.h>
+#include <itkGradientRecursiveGaussianImageFilter.h>
 #include <itkFlatStructuringElement.h>
 #include <itkMorphologicalWatershedFromMarkersImageFilter.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
@@ -62,46 +64,185 @@ Image<T> crop(const Image<T>& image, const Eigen::Vector3i& lo, const Eigen::Vec
   return out;
 }
 
-/// Automatic head search: the deepest point of the filled bone mask, on a grid
-/// of about options.search_spacing_mm, on the requested side of the
-/// volume's centre, with a depth that a joint head can have.
-bool findHead(const Mask& mask, const SegmentOptions& options, Eigen::Vector3d& center, double& depth) {
-  const ImageGeometry& g = mask.geometry;
-  Eigen::Vector3i factor;
-  for (int a = 0; a < 3; ++a)
-    factor[a] = std::max(1, static_cast<int>(std::lround(options.search_spacing_mm / g.spacing[a])));
-  Mask coarse;
+/// Morphological closing with a ball of `radius_mm`: bridges the speckled
+/// cancellous bone and thin cortex of real CT, so that hole filling can fill
+/// the head's interior.
+Mask close(const Mask& mask, double radius_mm) {
+  if (radius_mm <= 0) return mask;
+  using Ball = itk::FlatStructuringElement<3>;
+  Ball::RadiusType radius;
+  for (unsigned a = 0; a < 3; ++a)
+    radius[a] = static_cast<itk::SizeValueType>(std::max(1.0, std::round(radius_mm / mask.geometry.spacing[static_cast<int>(a)])));
+  auto filter = itk::BinaryMorphologicalClosingImageFilter<itk::Image<std::uint8_t, 3>, itk::Image<std::uint8_t, 3>, Ball>::New();
+  filter->SetInput(toItk(mask));
+  filter->SetKernel(Ball::Ball(radius));
+  filter->SetForegroundValue(1);
+  filter->SetSafeBorder(true);  // the volume's edge is not bone
+  filter->Update();
+  return fromItk<std::uint8_t>(filter->GetOutput());
+}
+
+bool insideVolume(const ImageGeometry& g, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d idx = g.toIndex(x);
+  return (idx.array() >= -0.5).all() && (idx.array() <= g.size.cast<double>().array() - 0.5).all();
+}
+
+/// Mean of f x f x f blocks (f per axis): the CT on the search's coarse grid.
+Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
+  const ImageGeometry& g = volume.geometry;
+  Volume coarse;
   coarse.geometry = g;
   for (int a = 0; a < 3; ++a) coarse.geometry.size[a] = (g.size[a] + factor[a] - 1) / factor[a];
   coarse.geometry.spacing = g.spacing.cwiseProduct(factor.cast<double>());
   // Block (0,0,0) covers voxels 0..f-1: its centre is at index (f-1)/2.
   coarse.geometry.origin = g.toPhysical((factor.cast<double>() - Eigen::Vector3d::Ones()) / 2.0);
-  // Majority pooling: "any bone" would bridge the joint gap.
-  std::vector<int> count(static_cast<size_t>(coarse.geometry.voxelCount()), 0);
+  std::vector<double> sum(static_cast<size_t>(coarse.geometry.voxelCount()), 0.0);
+  std::vector<int> count(sum.size(), 0);
   for (int k = 0; k < g.size[2]; ++k)
     for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i)
-        if (mask.at(i, j, k)) ++count[static_cast<size_t>(coarse.geometry.linear(i / factor[0], j / factor[1], k / factor[2]))];
-  const int block = factor.prod();
-  coarse.voxels.resize(count.size());
-  for (size_t n = 0; n < count.size(); ++n) coarse.voxels[n] = 2 * count[n] >= block ? 1 : 0;
-  const Image<float> distance = signedDistance(fillHoles(coarse));
-  const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
-  const double lo = 0.6 * options.min_head_radius_mm, hi = options.max_head_radius_mm;
-  depth = 0;
-  const ImageGeometry& cg = coarse.geometry;
-  for (int k = 0; k < cg.size[2]; ++k)
-    for (int j = 0; j < cg.size[1]; ++j)
-      for (int i = 0; i < cg.size[0]; ++i) {
-        const double d = -distance.at(i, j, k);
-        if (d < lo || d > hi || d <= depth) continue;
-        const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
-        // LPS: +x points to the patient's left.
-        if ((options.side == Side::Right) != (x[0] < mid_x)) continue;
-        depth = d;
-        center = x;
+      for (int i = 0; i < g.size[0]; ++i) {
+        const auto n = static_cast<size_t>(coarse.geometry.linear(i / factor[0], j / factor[1], k / factor[2]));
+        sum[n] += volume.at(i, j, k);
+        ++count[n];
       }
-  return depth > 0;
+  coarse.voxels.resize(sum.size());
+  for (size_t n = 0; n < sum.size(); ++n) coarse.voxels[n] = static_cast<float>(sum[n] / count[n]);
+  return coarse;
+}
+
+/// Automatic head search: a 3-D Hough transform for spheres on a grid of
+/// about options.search_spacing_mm. Every voxel on the bone's surface votes
+/// along its inward HU gradient at the distances a head radius can have; the
+/// normals of a spherical head meet in its centre, those of a shaft or a
+/// vertebral body only along a line, and a socket's point away from it. The
+/// strongest centre on the requested side is the head, its radius the median
+/// distance of the voters. Hand-written: ITK's Hough filters are 2-D only.
+bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector3d& center, double& radius) {
+  const ImageGeometry& g = volume.geometry;
+  Eigen::Vector3i factor;
+  for (int a = 0; a < 3; ++a)
+    factor[a] = std::max(1, static_cast<int>(std::lround(options.search_spacing_mm / g.spacing[a])));
+  const Volume coarse = blockMean(volume, factor);
+  const ImageGeometry& cg = coarse.geometry;
+  using FloatImage = itk::Image<float, 3>;
+  auto gradient = itk::GradientRecursiveGaussianImageFilter<FloatImage>::New();
+  gradient->SetInput(toItk(coarse));
+  gradient->SetSigma(cg.spacing.maxCoeff());
+  gradient->Update();
+  const auto* grad = gradient->GetOutput();
+
+  auto bone = [&](int i, int j, int k) {
+    const float hu = coarse.at(i, j, k);
+    return hu >= options.hu_min && hu <= options.hu_max;
+  };
+  struct Voter { Eigen::Vector3d x, n; };
+  std::vector<Voter> voters;
+  for (int k = 1; k + 1 < cg.size[2]; ++k)
+    for (int j = 1; j + 1 < cg.size[1]; ++j)
+      for (int i = 1; i + 1 < cg.size[0]; ++i) {
+        if (!bone(i, j, k)) continue;
+        if (bone(i - 1, j, k) && bone(i + 1, j, k) && bone(i, j - 1, k) && bone(i, j + 1, k) && bone(i, j, k - 1) &&
+            bone(i, j, k + 1))
+          continue;
+        const auto& gv = grad->GetPixel({{i, j, k}});
+        const Eigen::Vector3d n(gv[0], gv[1], gv[2]);  // physical (LPS) gradient
+        if (n.norm() <= 0) continue;
+        const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
+        if (options.roi_min && ((x.array() < options.roi_min->array()).any() || (x.array() > options.roi_max->array()).any()))
+          continue;
+        voters.push_back({x, n.normalized()});
+      }
+
+  // Votes along the inward normal, then summed over 3x3x3 cells: the
+  // discretised rays of one sphere spread over about one cell.
+  std::vector<float> votes(static_cast<size_t>(cg.voxelCount()), 0.0f);
+  const double step = 0.5 * cg.spacing.minCoeff();
+  const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
+  auto cellOf = [&](const Eigen::Vector3d& x, Eigen::Vector3i& v) {
+    v = cg.toIndex(x).array().round().cast<int>();
+    return (v.array() >= 0).all() && (v.array() < cg.size.array()).all();
+  };
+  for (const Voter& voter : voters)
+    for (double t = r_lo; t <= r_hi; t += step) {
+      Eigen::Vector3i v;
+      if (cellOf(voter.x + t * voter.n, v)) votes[static_cast<size_t>(cg.linear(v[0], v[1], v[2]))] += 1.0f;
+    }
+  const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
+  struct Peak { Eigen::Vector3d x; double votes, radius = 0, coverage = 0; };
+  std::vector<Peak> peaks;
+  for (int k = 1; k + 1 < cg.size[2]; ++k)
+    for (int j = 1; j + 1 < cg.size[1]; ++j)
+      for (int i = 1; i + 1 < cg.size[0]; ++i) {
+        double sum = 0;
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) sum += votes[static_cast<size_t>(cg.linear(i + di, j + dj, k + dk))];
+        const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
+        // LPS: +x points to the patient's left; the field of view is centred on the body.
+        if (sum > 0 && (options.side == Side::Right) == (x[0] < mid_x)) peaks.push_back({x, sum});
+      }
+  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.votes > b.votes; });
+  std::vector<Peak> kept;  // strongest first, at least a head radius apart
+  for (const Peak& p : peaks) {
+    bool separate = true;
+    for (const Peak& q : kept) separate = separate && (p.x - q.x).norm() > r_lo;
+    if (separate) kept.push_back(p);
+    if (kept.size() == 5) break;
+  }
+  // Each peak refined by a least-squares sphere through the surface voxels
+  // facing it at about its radius (the votes only locate it to a cell);
+  // coverage: the share of that sphere's surface that took part.
+  const double cell_area = cg.spacing.prod() / cg.spacing.minCoeff();
+  for (Peak& p : kept) {
+    std::vector<double> distances;
+    for (const Voter& voter : voters) {
+      const Eigen::Vector3d d = p.x - voter.x;
+      const double t = d.dot(voter.n);
+      if (t >= r_lo && t <= r_hi && (d - t * voter.n).norm() <= 1.5 * cg.spacing.minCoeff()) distances.push_back(t);
+    }
+    if (distances.empty()) continue;
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    p.radius = distances[distances.size() / 2];
+    size_t used = 0;
+    for (int iteration = 0; iteration < 5; ++iteration) {
+      // |x|^2 = 2 c.x + (r^2 - |c|^2): linear in c and the constant.
+      Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+      Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+      used = 0;
+      for (const Voter& voter : voters) {
+        const Eigen::Vector3d d = p.x - voter.x;
+        const double t = d.norm();
+        if (std::abs(t - p.radius) > 0.25 * p.radius || d.dot(voter.n) < 0.9 * t) continue;
+        const Eigen::Vector4d row(2 * voter.x[0], 2 * voter.x[1], 2 * voter.x[2], 1.0);
+        normal += row * row.transpose();
+        rhs += row * voter.x.squaredNorm();
+        ++used;
+      }
+      if (used < 10) break;
+      const Eigen::Vector4d sol = normal.ldlt().solve(rhs);
+      const Eigen::Vector3d c = sol.head<3>();
+      const double r2 = sol[3] + c.squaredNorm();
+      if (!(r2 > 0)) break;
+      p.x = c;
+      p.radius = std::sqrt(r2);
+    }
+    p.coverage = used * cell_area / (4 * M_PI * p.radius * p.radius);
+    log::debug("head candidate " + vec(p.x) + " mm: " + std::to_string(p.votes) + " votes, radius " +
+               std::to_string(p.radius) + " mm, coverage " + std::to_string(p.coverage));
+  }
+  // The strongest peak whose refined sphere is still a plausible head.
+  const Peak* best = nullptr;
+  for (const Peak& p : kept)
+    if (p.radius >= r_lo && p.radius <= r_hi && p.coverage >= options.min_coverage &&
+        (p.x[0] < mid_x) == (options.side == Side::Right) && std::abs(p.x[0] - mid_x) >= options.midline_margin_mm &&
+        insideVolume(g, p.x)) {
+      best = &p;
+      break;
+    }
+  if (!best) return false;
+  center = best->x;
+  radius = best->radius;
+  return true;
 }
 
 /// Marker watershed on the signed distance to the bone surface: the head's
@@ -152,6 +293,9 @@ void SegmentOptions::validate() const {
   if (!(min_head_radius_mm > 0 && min_head_radius_mm < max_head_radius_mm))
     throw UsageError("head radius range must satisfy 0 < min < max");
   if (!(search_spacing_mm > 0)) throw UsageError("search spacing must be > 0");
+  if (!(close_radius_mm >= 0)) throw UsageError("--close-radius must be >= 0");
+  if (!(midline_margin_mm >= 0)) throw UsageError("--midline-margin must be >= 0");
+  if (!(min_coverage >= 0 && min_coverage <= 1)) throw UsageError("--min-coverage must lie in [0, 1]");
 }
 
 Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSummary* summary_out) {
@@ -188,19 +332,19 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   if (options.seed_point) {
     center = *options.seed_point;
     summary.seed_source = "seed-point";
-    const Eigen::Vector3d idx = g.toIndex(center);
-    if ((idx.array() < -0.5).any() || (idx.array() > g.size.cast<double>().array() - 0.5).any())
+    if (!insideVolume(g, center))
       throw InputError("--seed-point " + vec(center) + " lies outside the volume");
     depth = options.max_head_radius_mm;  // crop generously around a given seed
   } else {
     const std::string joint = options.joint == Joint::Hip ? "hip" : "shoulder";
     const std::string side = options.side == Side::Right ? "right" : "left";
     summary.seed_source = "automatic (" + joint + ", " + side + ")";
-    if (!findHead(mask, options, center, depth)) {
+    if (!findHead(volume, options, center, depth)) {
       std::ostringstream m;
       m << "no " << (options.joint == Joint::Hip ? "femoral" : "humeral") << " head found on the " << side
-        << " side: no bone deeper than " << 0.6 * options.min_head_radius_mm
-        << " mm in the HU window; give --seed-point X,Y,Z (LPS mm) or adjust --hu-min";
+        << " side: no sphere of radius " << options.min_head_radius_mm << "-" << options.max_head_radius_mm
+        << " mm covers " << options.min_coverage << " of its surface with bone in the HU window (-v lists the candidates);"
+        << " give --seed-point X,Y,Z (LPS mm) or adjust --hu-min";
       throw ProcessingError(m.str());
     }
     log::info("head found at " + vec(center) + " mm, depth " + std::to_string(depth) + " mm");
@@ -222,9 +366,10 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   lo = lo.cwiseMax(0);
   hi = hi.cwiseMin(g.size - Eigen::Vector3i::Ones());
   // The joint gap is a narrow dark valley between two bright cortices; where
-  // partial volume lifts it into the HU window, the black top-hat (closing
-  // minus image) finds it, and those voxels leave the bone mask.
-  Mask box_raw = crop(mask, lo, hi);
+  // partial volume lifts it into the HU window, or the closing bridges it,
+  // the black top-hat (closing minus image) finds it, and those voxels leave
+  // the bone mask.
+  Mask box_raw = close(crop(mask, lo, hi), options.close_radius_mm);
   const Volume box_hu = crop(volume, lo, hi);
   if (options.gap_contrast_hu > 0) {
     using FloatImage = itk::Image<float, 3>;
@@ -246,9 +391,12 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   const Mask box_mask = fillHoles(box_raw);
   const ImageGeometry& bg = box_mask.geometry;
   const Image<float> box_distance = signedDistance(box_mask);
-  {
-    // Re-centre on the deepest full-resolution bone near the search's centre:
-    // the coarse grid can bridge a narrow joint gap and shift it.
+  // A seed point is only somewhere inside the head: re-centre on the deepest
+  // full-resolution bone near it, and once more on the label's deepest point
+  // (the seed can sit off-centre where bone is joined). The automatic
+  // search's sphere is already centred.
+  const bool recentre = options.seed_point.has_value();
+  if (recentre) {
     const Eigen::Vector3d start = center;
     double deepest = 0;
     for (int k = 0; k < bg.size[2]; ++k)
@@ -263,11 +411,10 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     if (deepest > 0) depth = deepest;
   }
 
-  // 4-6. Watershed from markers, then re-centred once on the label's deepest
-  //      point (the search's centre can sit off-centre where bone is joined).
+  // 4-6. Watershed from markers.
   Mask head;
   double best = 0;
-  for (int pass = 0; pass < 2; ++pass) {
+  for (int pass = 0; pass < (recentre ? 2 : 1); ++pass) {
     const double r = pass == 0 ? depth : best;
     if (pass == 1) center = summary.head_center_mm;
     head = watershedHead(box_distance, box_mask, center, r);
@@ -282,6 +429,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
           }
     if (best < 0.5 * options.min_head_radius_mm) break;  // no head to re-centre on
   }
+  if (!recentre) summary.head_center_mm = center, summary.search_radius_mm = depth;
   summary.head_depth_mm = best;
   if (best < 0.5 * options.min_head_radius_mm)
     summary.warnings.push_back("the labelled head is thin (depth " + std::to_string(best) +

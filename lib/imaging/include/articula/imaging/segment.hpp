@@ -1,7 +1,7 @@
 #pragma once
 // Segmentation of one joint head (femoral or humeral) from a CT volume:
-// HU threshold, optional ROI, hole filling, automatic head finding (the
-// deepest bone point on the chosen side, on a ~2 mm grid), then a marker
+// HU threshold, optional ROI, closing and hole filling, automatic head
+// finding (a Hough transform for spheres on the chosen side, ~2 mm grid), then a marker
 // watershed on the distance to the bone surface, which cuts the head from
 // the socket and the neck at the narrow bone bridges between them.
 #include <optional>
@@ -27,6 +27,9 @@ struct SegmentOptions {
   double min_head_radius_mm = 15.0;                 // plausible joint heads
   double max_head_radius_mm = 35.0;
   double search_spacing_mm = 2.0;                   // grid of the automatic head search
+  double close_radius_mm = 5.0;  // closing before hole filling: bridges speckled cancellous bone (0: off)
+  double min_coverage = 0.15;       // least share of a found head's sphere that is bone surface
+  double midline_margin_mm = 30.0;  // a found head lies this far from the volume's mid-sagittal plane (not the spine)
   double gap_width_mm = 4.0;     // widest joint gap the valley filter closes
   double gap_contrast_hu = 300;  // black top-hat above which a voxel is gap, not bone (0: off)
   double surface_hu = 400;       // level of the head's final surface (<= hu_min: the window's end)
@@ -37,8 +40,11 @@ struct SegmentOptions {
 struct SegmentSummary {
   std::string seed_source;                  // "seed-point" or "automatic (joint, side)"
   Eigen::Vector3d seed_mm = Eigen::Vector3d::Zero();
-  Eigen::Vector3d head_center_mm = Eigen::Vector3d::Zero();  // deepest point of the label
-  double head_depth_mm = 0;                 // its distance to the label surface (~ head radius)
+  // Automatic search: the centre of the head's sphere; with a seed point:
+  // the deepest point of the label.
+  Eigen::Vector3d head_center_mm = Eigen::Vector3d::Zero();
+  double search_radius_mm = 0;              // the automatic search's sphere radius (0 with a seed point)
+  double head_depth_mm = 0;                 // deepest label point's distance to the label surface
   long long threshold_voxels = 0;           // voxels in the HU window (within the ROI)
   long long label_voxels = 0;
   std::vector<std::string> warnings;
