@@ -388,6 +388,16 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
         box_raw.voxels[n] = 0, ++removed;
     log::debug("joint-gap valley: " + std::to_string(removed) + " voxels removed from the bone mask");
   }
+  if (!options.seed_point) {
+    // The found sphere's core is the head's cancellous interior, whatever its
+    // HU: osteoporotic or lossy-compressed bone falls below the window and,
+    // where the cortex has gaps, hole filling cannot reach it.
+    const ImageGeometry& rg = box_raw.geometry;
+    for (int k = 0; k < rg.size[2]; ++k)
+      for (int j = 0; j < rg.size[1]; ++j)
+        for (int i = 0; i < rg.size[0]; ++i)
+          if ((rg.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm() < 0.7 * depth) box_raw.at(i, j, k) = 1;
+  }
   const Mask box_mask = fillHoles(box_raw);
   const ImageGeometry& bg = box_mask.geometry;
   const Image<float> box_distance = signedDistance(box_mask);
