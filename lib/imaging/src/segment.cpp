@@ -8,7 +8,7 @@
 #include <itkBinaryFillholeImageFilter.h>
 #include <itkBinaryMorphologicalClosingImageFilter.h>
 #include <itkBlackTopHatImageFilter.h>
-#include <itkGradientRecursiveGaussianImageFilter.h>
+#include <itkSmoothingRecursiveGaussianImageFilter.h>
 #include <itkFlatStructuringElement.h>
 #include <itkMorphologicalWatershedFromMarkersImageFilter.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
@@ -112,11 +112,13 @@ Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
 
 /// Automatic head search: a 3-D Hough transform for spheres on a grid of
 /// about options.search_spacing_mm. Every voxel on the bone's surface votes
-/// along its inward HU gradient at the distances a head radius can have; the
+/// along its inward HU gradient at the distances a head radius can have: the
 /// normals of a spherical head meet in its centre, those of a shaft or a
 /// vertebral body only along a line, and a socket's point away from it. The
-/// strongest centre on the requested side is the head, its radius the median
-/// distance of the voters. Hand-written: ITK's Hough filters are 2-D only.
+/// strongest centres are refined by a least-squares sphere on the surface
+/// voxels facing them; the strongest on the requested side whose sphere is a
+/// plausible head is the head.
+/// Hand-written: ITK's Hough filters are 2-D only.
 bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector3d& center, double& radius) {
   const ImageGeometry& g = volume.geometry;
   Eigen::Vector3i factor;
@@ -124,12 +126,14 @@ bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector
     factor[a] = std::max(1, static_cast<int>(std::lround(options.search_spacing_mm / g.spacing[a])));
   const Volume coarse = blockMean(volume, factor);
   const ImageGeometry& cg = coarse.geometry;
+  // Smoothed once; the gradient is then taken only where it is needed (a
+  // gradient filter would fill three components at every voxel).
   using FloatImage = itk::Image<float, 3>;
-  auto gradient = itk::GradientRecursiveGaussianImageFilter<FloatImage>::New();
-  gradient->SetInput(toItk(coarse));
-  gradient->SetSigma(cg.spacing.maxCoeff());
-  gradient->Update();
-  const auto* grad = gradient->GetOutput();
+  auto smoothing = itk::SmoothingRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
+  smoothing->SetInput(toItk(coarse));
+  smoothing->SetSigma(cg.spacing.maxCoeff());
+  smoothing->Update();
+  const Volume smooth = fromItk<float>(smoothing->GetOutput());
 
   auto bone = [&](int i, int j, int k) {
     const float hu = coarse.at(i, j, k);
@@ -144,8 +148,11 @@ bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector
         if (bone(i - 1, j, k) && bone(i + 1, j, k) && bone(i, j - 1, k) && bone(i, j + 1, k) && bone(i, j, k - 1) &&
             bone(i, j, k + 1))
           continue;
-        const auto& gv = grad->GetPixel({{i, j, k}});
-        const Eigen::Vector3d n(gv[0], gv[1], gv[2]);  // physical (LPS) gradient
+        const Eigen::Vector3d index_gradient(smooth.at(i + 1, j, k) - smooth.at(i - 1, j, k),
+                                             smooth.at(i, j + 1, k) - smooth.at(i, j - 1, k),
+                                             smooth.at(i, j, k + 1) - smooth.at(i, j, k - 1));
+        // Physical (LPS) gradient: d/dx = D^-T diag(1/spacing) d/dijk.
+        const Eigen::Vector3d n = cg.direction * index_gradient.cwiseQuotient(cg.spacing);
         if (n.norm() <= 0) continue;
         const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
         if (options.roi_min && ((x.array() < options.roi_min->array()).any() || (x.array() > options.roi_max->array()).any()))
@@ -280,7 +287,11 @@ Mask watershedHead(const Image<float>& distance, const Mask& bone, const Eigen::
   head.geometry = bg;
   head.voxels.resize(regions.voxels.size());
   for (size_t n = 0; n < regions.voxels.size(); ++n) head.voxels[n] = regions.voxels[n] == 1 && bone.voxels[n];
-  return fillHoles(head);
+  // A head is a solid: closing with a ball of a third of its radius bridges
+  // the gaps of a thin or porous cortex (osteoporotic or lossy-compressed
+  // bone falls below the window), so that its interior fills. Its convex
+  // articular surface is left as it is.
+  return fillHoles(close(head, r / 3));
 }
 
 }  // namespace
@@ -387,16 +398,6 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
       if (box_raw.voxels[n] && valley.voxels[n] > options.gap_contrast_hu && box_hu.voxels[n] < options.surface_hu)
         box_raw.voxels[n] = 0, ++removed;
     log::debug("joint-gap valley: " + std::to_string(removed) + " voxels removed from the bone mask");
-  }
-  if (!options.seed_point) {
-    // The found sphere's core is the head's cancellous interior, whatever its
-    // HU: osteoporotic or lossy-compressed bone falls below the window and,
-    // where the cortex has gaps, hole filling cannot reach it.
-    const ImageGeometry& rg = box_raw.geometry;
-    for (int k = 0; k < rg.size[2]; ++k)
-      for (int j = 0; j < rg.size[1]; ++j)
-        for (int i = 0; i < rg.size[0]; ++i)
-          if ((rg.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm() < 0.7 * depth) box_raw.at(i, j, k) = 1;
   }
   const Mask box_mask = fillHoles(box_raw);
   const ImageGeometry& bg = box_mask.geometry;

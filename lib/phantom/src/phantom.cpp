@@ -26,8 +26,8 @@ double cylinderDepth(const Vector3d& x, const Vector3d& a, const Vector3d& b, do
 /// The phantom's tissues as a function of position.
 struct Anatomy {
   std::unique_ptr<geometry::PosedSurface> head;
-  Vector3d center, neck_end, shaft_top, shaft_bottom, trochanter, socket_axis;
-  double neck_radius, shaft_radius, trochanter_radius, gap, socket_wall = 12.0, socket_half_angle_cos;
+  Vector3d center, neck_end, shaft_top, shaft_bottom, trochanter, trochanter_axes, socket_axis;
+  double neck_radius, shaft_radius, gap, socket_wall = 12.0, socket_half_angle_cos;
   const PhantomOptions* o;
 
   /// Approximate signed depth below the head surface, -F / |grad F| (exact to
@@ -37,11 +37,25 @@ struct Anatomy {
     return -e.value / std::max(e.gradient.norm(), 1e-9);
   }
 
+  /// Approximate signed depth inside the greater trochanter: an elongated
+  /// ellipsoidal prominence (not a sphere, which no real trochanter is).
+  double trochanterDepth(const Vector3d& x) const {
+    const Vector3d u = (x - trochanter).cwiseQuotient(trochanter_axes);
+    const double q = u.norm();
+    if (q < 1e-12) return trochanter_axes.minCoeff();
+    const Vector3d grad = u.cwiseQuotient(trochanter_axes) / q;
+    return (1.0 - q) / grad.norm();
+  }
+
+  /// Signed depth inside the femur: head, neck, shaft and trochanter.
+  double femurDepth(const Vector3d& x) const {
+    return std::max({headDepth(x), cylinderDepth(x, center, neck_end, neck_radius),
+                     cylinderDepth(x, shaft_top, shaft_bottom, shaft_radius), trochanterDepth(x)});
+  }
+
   /// HU at x and the distance to the nearest tissue interface (mm).
   double hu(const Vector3d& x, double& interface) const {
-    const double femur = std::max({headDepth(x), cylinderDepth(x, center, neck_end, neck_radius),
-                                   cylinderDepth(x, shaft_top, shaft_bottom, shaft_radius),
-                                   trochanter_radius - (x - trochanter).norm()});
+    const double femur = femurDepth(x);
     // The acetabulum: a shell from gap to gap + wall outside the head, within a cone about the socket axis.
     const double outside = -headDepth(x);
     const Vector3d u = (x - center).normalized();
@@ -132,7 +146,7 @@ Phantom makePhantom(const PhantomOptions& o) {
   a.shaft_top = a.neck_end + Vector3d(s * 6.0, 0.0, 10.0);
   a.shaft_bottom = a.shaft_top - Vector3d(0, 0, 400.0);
   a.trochanter = a.shaft_top + Vector3d(s * 4.0, 0.0, 0.0);
-  a.trochanter_radius = 17.0;
+  a.trochanter_axes = Vector3d(13.0, 15.0, 20.0);  // lateral, anterior-posterior, vertical (mm)
   a.socket_axis = (-neck_axis + Vector3d(0, 0, 0.3)).normalized();
   a.socket_half_angle_cos = std::cos(80.0 * M_PI / 180.0);
   a.gap = o.gap_mm;
@@ -177,10 +191,7 @@ Phantom makePhantom(const PhantomOptions& o) {
           value /= sub * sub * sub;
         }
         out.ct.at(i, j, k) = static_cast<float>(value);
-        const double femur = std::max({a.headDepth(x), cylinderDepth(x, a.center, a.neck_end, a.neck_radius),
-                                       cylinderDepth(x, a.shaft_top, a.shaft_bottom, a.shaft_radius),
-                                       a.trochanter_radius - (x - a.trochanter).norm()});
-        out.femur.at(i, j, k) = femur > 0 ? 1 : 0;
+        out.femur.at(i, j, k) = a.femurDepth(x) > 0 ? 1 : 0;
       }
   blur(out.ct, o.blur_mm);
   std::normal_distribution<double> noise(0.0, o.noise_hu);

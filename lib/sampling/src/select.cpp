@@ -140,18 +140,50 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
     parameters.cluster_epsilon = 3.0 * o.band_mm;
     parameters.normal_threshold = std::cos(o.normal_deg * M_PI / 180.0);
     ransac.detect(parameters);
-    size_t best_count = 0;
+    // Every plausible RANSAC sphere is grown into its patch: the band around
+    // it with radial normals, the largest connected part, then once more
+    // around the least-squares sphere of that patch. The largest final patch
+    // is the articular surface (RANSAC's own point count favours whichever
+    // sphere it met first on a rough, clipped head).
+    const double cos_tol = std::cos(o.normal_deg * M_PI / 180.0);
+    auto grow = [&](Selection patch) {
+      for (int pass = 0; pass < 2; ++pass) {
+        std::vector<char> chosen(static_cast<size_t>(n), 0);
+        for (Eigen::Index v = 0; v < n; ++v) {
+          const Eigen::Vector3d d = V.row(v).transpose() - patch.sphere_center;
+          const double r = d.norm();
+          chosen[static_cast<size_t>(v)] =
+              std::fabs(r - patch.sphere_radius) <= o.band_mm && N.row(v).dot(d.transpose()) >= cos_tol * r;
+        }
+        patch.indices = largestPatch(chosen, F);
+        if (static_cast<int>(patch.indices.size()) < std::max(o.min_points, 4)) break;
+        Eigen::MatrixX3d P(static_cast<Eigen::Index>(patch.indices.size()), 3);
+        for (size_t i = 0; i < patch.indices.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(patch.indices[i]);
+        fitSphere(P, patch.sphere_center, patch.sphere_radius);
+        patch.sphere_rms_mm = std::sqrt(
+            ((P.rowwise() - patch.sphere_center.transpose()).rowwise().norm().array() - patch.sphere_radius).square().mean());
+      }
+      return patch;
+    };
     for (const auto& shape : ransac.shapes()) {
       const auto* sphere = dynamic_cast<const RansacSphere*>(shape.get());
       if (!sphere) continue;
       const double r = sphere->radius();
       if (r < o.min_radius_mm || r > o.max_radius_mm) continue;
       ++sel.ransac_spheres;
-      if (shape->indices_of_assigned_points().size() > best_count) {
-        best_count = shape->indices_of_assigned_points().size();
-        const auto c = sphere->center();
-        sel.sphere_center = Eigen::Vector3d(c.x(), c.y(), c.z());
-        sel.sphere_radius = r;
+      Selection start;
+      start.sphere_center = Eigen::Vector3d(sphere->center().x(), sphere->center().y(), sphere->center().z());
+      start.sphere_radius = r;
+      const Selection patch = grow(start);
+      std::ostringstream m;
+      m << "RANSAC sphere (" << start.sphere_center.transpose() << ") mm, radius " << r << " mm ("
+        << shape->indices_of_assigned_points().size() << " points) -> patch of " << patch.indices.size()
+        << " vertices, radius " << patch.sphere_radius << " mm";
+      log::debug(m.str());
+      if (patch.indices.size() > sel.indices.size()) {
+        const int found = sel.ransac_spheres;
+        sel = patch;
+        sel.ransac_spheres = found;
       }
     }
     if (sel.ransac_spheres == 0) {
@@ -159,24 +191,6 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
       m << "no joint head found: RANSAC found no sphere of radius " << o.min_radius_mm << "-" << o.max_radius_mm
         << " mm on the mesh (" << n << " vertices); select the region by hand with --select sphere:X,Y,Z,R";
       throw ProcessingError(m.str());
-    }
-    // Band around the sphere, normals radial, largest connected patch; then
-    // once more around the least-squares sphere of that patch.
-    const double cos_tol = std::cos(o.normal_deg * M_PI / 180.0);
-    for (int pass = 0; pass < 2; ++pass) {
-      std::vector<char> chosen(static_cast<size_t>(n), 0);
-      for (Eigen::Index v = 0; v < n; ++v) {
-        const Eigen::Vector3d d = V.row(v).transpose() - sel.sphere_center;
-        const double r = d.norm();
-        chosen[static_cast<size_t>(v)] = std::fabs(r - sel.sphere_radius) <= o.band_mm &&
-                                          N.row(v).dot(d.transpose()) >= cos_tol * r;
-      }
-      sel.indices = largestPatch(chosen, F);
-      if (static_cast<int>(sel.indices.size()) < std::max(o.min_points, 4)) break;
-      Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3);
-      for (size_t i = 0; i < sel.indices.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(sel.indices[i]);
-      fitSphere(P, sel.sphere_center, sel.sphere_radius);
-      sel.sphere_rms_mm = std::sqrt(((P.rowwise() - sel.sphere_center.transpose()).rowwise().norm().array() - sel.sphere_radius).square().mean());
     }
   }
   if (static_cast<int>(sel.indices.size()) < o.min_points)
