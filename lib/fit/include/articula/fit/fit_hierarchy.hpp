@@ -38,12 +38,12 @@ struct Options {
   std::vector<geometry::ShapeModel> models = geometry::allModels();  // what to report (ancestors are fitted anyway)
   Objective objective = Objective::Geometric;
   Strategy strategy = Strategy::Local;
-  std::string local_algorithm = "LD_SLSQP";  // or LN_BOBYQA, LD_LBFGS, LD_MMA, LD_TNEWTON_PRECOND_RESTART
+  std::string local_algorithm = "LM";  // Levenberg-Marquardt (ours); or NLopt LD_SLSQP, LN_BOBYQA, LD_LBFGS, ...
   unsigned seed = 42;                  // NLopt's random seed (CRS2)
   int max_evaluations = 4000;          // per local run
   int global_evaluations = 3000;       // per global run (GlobalLocal)
   int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
-  int screening_evaluations = 40;      // models with several starts: evaluations per start before the best is finished
+  int screening_evaluations = 20;      // models with several starts: evaluations per start before the best is finished
   int screening_points = 400;          // screen the starts on about this many of the points (every k-th; 0 = all)
   double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
   double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
