@@ -39,7 +39,10 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
       result.termination = "evaluation limit reached";
       break;
     }
-    const MatrixXd A = J.transpose() * J;
+    // J^T J through its lower half (half the work of the full product).
+    MatrixXd A = MatrixXd::Zero(n, n);
+    A.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+    A = A.selfadjointView<Eigen::Lower>();
     const VectorXd g = J.transpose() * r;  // half the gradient of |r|^2
     scale = scale.cwiseMax(A.diagonal()).cwiseMax(1e-300);
     if (mu < 0.0) mu = 1e-3;
