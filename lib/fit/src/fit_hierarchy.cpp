@@ -434,9 +434,15 @@ ShapeParameters releaseOvoidScales(ShapeParameters p, const Bounds& model_bounds
     }
     if (!(factor > 0.0 && factor < 1.0)) continue;
     out[a.radius] = x[a.radius] * factor;
-    out.segment(a.c0, 4) = x.segment(a.c0, 4) / factor;
+    out.segment(a.c0, 4) = (x.segment(a.c0, 4) / factor)  // the limiting c_j lands on its bound up to rounding
+                               .cwiseMax(model_bounds.lower.segment(a.c0, 4))
+                               .cwiseMin(model_bounds.upper.segment(a.c0, 4));
   }
-  return geometry::fromVector(p.model, out);
+  try {
+    return geometry::fromVector(p.model, out);
+  } catch (const InvalidParameter&) {
+    return p;  // e.g. bounds overridden beyond the valid set: keep the held form
+  }
 }
 
 ShapeParameters wrapAngles(ShapeParameters p) {

@@ -53,7 +53,7 @@ struct Options {
   int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
   int screening_evaluations = 40;      // models with several starts: evaluations per start before the best is finished
   int screening_points = 400;          // screen the starts on about this many of the points (every k-th; 0 = all)
-  int screening_finalists = 2;         // then finish this many of the best (distinct) on all points
+  int screening_finalists = 3;         // then finish this many of the best (distinct) on all points
   double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
   double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
   // Bounds (thesis section 3.2.5), around the reference ellipsoid start:
