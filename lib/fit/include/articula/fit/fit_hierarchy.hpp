@@ -7,7 +7,7 @@
 // The local method, chosen by measurement (docs/benchmarks.md, bench-fit):
 // Levenberg-Marquardt on the residuals themselves (orthogonal distance
 // fitting, Ahn 2004: the Jacobian of the signed distances is dF/dlambda /
-// |grad F| at the closest points), about 7x faster than NLopt's best
+// |grad F| at the closest points), about 3x faster than NLopt's best
 // (LD_SLSQP on the summed squares) to the same optima. NLopt stays for the
 // optional global search (GN_CRS2_LM, Strategy::GlobalLocal) and as the
 // alternative local methods.
