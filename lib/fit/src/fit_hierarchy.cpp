@@ -516,10 +516,12 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
     // finish the best few distinct ones.
     std::stable_sort(screened.begin(), screened.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& s : starts) screened_labels += (screened_labels.empty() ? "" : ",") + s.label;
-    starts.clear();
-    for (size_t i = 0; i < screened.size() && static_cast<int>(starts.size()) < o.screening_finalists; ++i)
-      if (i == 0 || screened[i].first > screened[i - 1].first * (1.0 + 1e-9)) starts.push_back(screened[i].second);
+    if (!screened.empty()) {  // else (no valid start) every start is run as it is
+      for (const auto& s : starts) screened_labels += (screened_labels.empty() ? "" : ",") + s.label;
+      starts.clear();
+      for (size_t i = 0; i < screened.size() && static_cast<int>(starts.size()) < o.screening_finalists; ++i)
+        if (i == 0 || screened[i].first > screened[i - 1].first * (1.0 + 1e-9)) starts.push_back(screened[i].second);
+    }
   }
   best.evaluations = screening_evaluations;
   for (const Start& start : starts) {
@@ -531,7 +533,7 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
     // The global search explores the whole box: once per model is enough
     // (from the best screened start).
     const bool search_globally = o.strategy == Strategy::GlobalLocal && model != ShapeModel::Sphere &&
-                        (screened_labels.empty() || &start == &starts.front());
+                                 (screened_labels.empty() || &start == &starts.front());
     if (search_globally) {
       const RunResult global =
           runNlopt(nlopt::GN_CRS2_LM, model, x0, b, steps, o.global_evaluations, points, start.feet, o);
@@ -542,8 +544,10 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
       run = runLocal(model, x0, b, steps, o.max_evaluations, points, start.feet, o);
     }
     evaluations += run.evaluations;
-    // SLSQP's objective test can stop on a short step while still descending:
-    // restart (a fresh quasi-Newton model) while that still gains.
+    // A run can stop on a short step while still descending (SLSQP's
+    // objective test; LM after heavy damping): restart (a fresh quasi-Newton
+    // model or damping) while that still gains. With LM this costs 2-3
+    // evaluations per model.
     for (int restart = 0; restart < o.restarts; ++restart) {
       const RunResult again = runLocal(model, run.x, b, steps, o.max_evaluations, points, run.feet, o);
       evaluations += again.evaluations;

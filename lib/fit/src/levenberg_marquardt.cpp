@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <Eigen/Cholesky>
 
@@ -27,7 +28,7 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
   MatrixXd J;
   problem.accept(J);
   VectorXd scale = VectorXd::Zero(n);  // Marquardt's D^2: the largest diag(J^T J) so far
-  double mu = -1.0, nu = 2.0;
+  double mu = 1e-3, nu = 2.0;  // damping (relative to the scale) and its growth on rejection
   VectorXd r_trial;
   for (;;) {
     if (result.cost <= o.absolute_cost) {
@@ -45,7 +46,6 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
     A = A.selfadjointView<Eigen::Lower>();
     const VectorXd g = J.transpose() * r;  // half the gradient of |r|^2
     scale = scale.cwiseMax(A.diagonal()).cwiseMax(1e-300);
-    if (mu < 0.0) mu = 1e-3;
     // The damped Gauss-Newton step, with the variables at a bound that the
     // descent direction -g would leave held there, and those the step would
     // carry across a bound stopped on it and held while the rest is solved
