@@ -75,7 +75,7 @@ class FitCommand : public cli::Command {
         ->capture_default_str();
     app.add_option("--strategy", strategy_, "local (from the hierarchical start) or global-local (GN_CRS2_LM first)")
         ->capture_default_str();
-    app.add_option("--local-algorithm", local_algorithm_, "NLopt local method: LD_SLSQP, LN_BOBYQA, LD_LBFGS, LD_MMA")
+    app.add_option("--local-algorithm", local_algorithm_, "Local method: LM (Levenberg-Marquardt on the residuals) or NLopt's LD_SLSQP, LN_BOBYQA, LD_LBFGS, LD_MMA")
         ->capture_default_str();
     app.add_option("--max-evaluations", max_evaluations_, "Evaluation cap per local run")->capture_default_str();
     app.add_option("--bounds", bounds_file_, "JSON of parameter bounds overrides, e.g. {\"gamma1\": [2, 3]}");
@@ -130,8 +130,8 @@ class FitCommand : public cli::Command {
  private:
   std::filesystem::path input_, output_, bounds_file_;
   std::vector<std::string> models_ = {"sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid"};
-  std::string objective_ = "geometric", strategy_ = "local", local_algorithm_ = "LD_SLSQP";
-  int max_evaluations_ = 4000;
+  std::string objective_ = "geometric", strategy_ = "local", local_algorithm_ = fit::Options{}.local_algorithm;
+  int max_evaluations_ = fit::Options{}.max_evaluations;
 };
 
 ARTICULA_REGISTER_COMMAND(FitCommand)

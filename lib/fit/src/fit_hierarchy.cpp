@@ -13,6 +13,7 @@
 #include "articula/core/log.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
+#include "articula/fit/levenberg_marquardt.hpp"
 #include "articula/fit/parameter_gradient.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
@@ -37,11 +38,14 @@ Strategy strategyFromName(const std::string& name) {
 }
 
 namespace {
+// Our Levenberg-Marquardt (levenberg_marquardt.hpp) in place of an NLopt method.
+const std::string kLevenbergMarquardt = "LM";
+
 nlopt::algorithm localAlgorithm(const std::string& name) {
   for (auto a : {nlopt::LN_BOBYQA, nlopt::LD_SLSQP, nlopt::LD_LBFGS, nlopt::LD_MMA, nlopt::LD_TNEWTON_PRECOND_RESTART})
     if (name == nlopt::algorithm_name(a) || name == nlopt_algorithm_to_string(static_cast<nlopt_algorithm>(a)))
       return a;
-  throw UsageError("local_algorithm: expected LN_BOBYQA, LD_SLSQP, LD_LBFGS, LD_MMA or LD_TNEWTON_PRECOND_RESTART, found '" +
+  throw UsageError("local_algorithm: expected LM, LN_BOBYQA, LD_SLSQP, LD_LBFGS, LD_MMA or LD_TNEWTON_PRECOND_RESTART, found '" +
                    name + "'");
 }
 
@@ -52,11 +56,12 @@ void Options::validate() const {
     if (!ok) throw UsageError("fit options: " + what);
   };
   require(!models.empty(), "models: expected at least one model");
-  localAlgorithm(local_algorithm);
+  if (local_algorithm != kLevenbergMarquardt) localAlgorithm(local_algorithm);
   require(max_evaluations > 0, "max_evaluations: expected > 0");
   require(global_evaluations > 0, "global_evaluations: expected > 0");
   require(screening_evaluations >= 0 && screening_points >= 0 && restarts >= 0,
           "screening_evaluations, screening_points, restarts: expected >= 0");
+  require(screening_finalists >= 1, "screening_finalists: expected >= 1");
   require(relative_tolerance >= 0.0 && parameter_tolerance >= 0.0, "tolerances: expected >= 0");
   require(radius_interval > 0.0 && radius_interval < 1.0, "radius_interval: expected in (0, 1)");
   require(center_interval > 0.0, "center_interval: expected > 0");
@@ -152,13 +157,81 @@ VectorXd initialSteps(ShapeModel model, const ShapeParameters& start) {
   return step;
 }
 
+// The residuals of the objective: F(x_i) (algebraic) or the signed distance
+// d_i (geometric; `feet` are warm starts on entry, closest points on exit).
+// Throws InvalidParameter outside the valid set.
+void residuals(const ShapeParameters& p, Objective kind, const Eigen::MatrixX3d& points, VectorXd& r,
+               Eigen::MatrixX3d& feet) {
+  if (kind == Objective::Algebraic) {
+    const auto surface = geometry::makeSurface(p);
+    r.resize(points.rows());
+    for (Eigen::Index i = 0; i < points.rows(); ++i) r[i] = surface->value(points.row(i).transpose());
+  } else {
+    distance::SignedDistance(p).evaluate(points, r, feet, feet.rows() == points.rows());
+  }
+}
+
+// Their Jacobian (#P x M): dF/dlambda at the points, or, for the signed
+// distances, dF/dlambda / |grad F| at the closest points `feet` (the envelope
+// theorem; orthogonal distance fitting, Ahn 2004).
+Eigen::MatrixXd residualJacobian(const ShapeParameters& p, Objective kind, const Eigen::MatrixX3d& points,
+                                 const Eigen::MatrixX3d& feet) {
+  Eigen::MatrixXd J;
+  VectorXd norms;
+  if (kind == Objective::Algebraic) {
+    parameterGradient(p, points, J, norms);
+  } else {
+    parameterGradient(p, feet, J, norms);
+    J.array().colwise() /= norms.array();
+  }
+  return J;
+}
+
+// The residuals as a least-squares problem for levenbergMarquardt, with the
+// closest points of the current parameters as warm starts for the next
+// (`feet`: those of the start, if known; else empty).
+class ResidualProblem : public LeastSquaresProblem {
+ public:
+  ResidualProblem(ShapeModel model, const Eigen::MatrixX3d& points, Objective kind, Eigen::MatrixX3d feet)
+      : model_(model), points_(points), kind_(kind), feet_(std::move(feet)) {}
+
+  const Eigen::MatrixX3d& feet() const { return feet_; }
+
+  bool evaluate(const VectorXd& x, VectorXd& r) override {
+    try {
+      trial_ = geometry::fromVector(model_, x);
+      trial_feet_ = feet_;
+      residuals(trial_, kind_, points_, r, trial_feet_);
+      return true;
+    } catch (const InvalidParameter&) {
+      return false;  // e.g. an ovoid denominator reaching 0 on [-1, 1]
+    }
+  }
+
+  void accept(Eigen::MatrixXd& J) override {
+    feet_.swap(trial_feet_);
+    J = residualJacobian(trial_, kind_, points_, feet_);
+  }
+
+ private:
+  ShapeModel model_;
+  const Eigen::MatrixX3d& points_;
+  Objective kind_;
+  Eigen::MatrixX3d feet_, trial_feet_;
+  ShapeParameters trial_;
+};
+
 // The objective seen by NLopt, in scaled variables x = (lambda - lambda0) / s
 // so that every parameter moves on a unit scale; it remembers the best point
 // it was shown, so a run never returns anything worse than its start.
 class ObjectiveFunction {
  public:
-  ObjectiveFunction(ShapeModel model, const Eigen::MatrixX3d& points, Objective kind, VectorXd origin, VectorXd scale)
-      : model_(model), points_(points), kind_(kind), origin_(std::move(origin)), scale_(std::move(scale)) {}
+  ObjectiveFunction(ShapeModel model, const Eigen::MatrixX3d& points, Objective kind, VectorXd origin, VectorXd scale,
+                    Eigen::MatrixX3d feet)
+      : model_(model), points_(points), kind_(kind), origin_(std::move(origin)), scale_(std::move(scale)),
+        best_feet_(std::move(feet)) {}
+
+  const Eigen::MatrixX3d& bestFeet() const { return best_feet_; }
 
   VectorXd toLambda(const double* x) const {
     return origin_ + scale_.cwiseProduct(Eigen::Map<const VectorXd>(x, origin_.size()));
@@ -170,15 +243,8 @@ class ObjectiveFunction {
     double f = 0.0;
     try {
       const ShapeParameters p = geometry::fromVector(model_, lambda);
-      if (kind_ == Objective::Algebraic) {
-        const auto surface = geometry::makeSurface(p);
-        d_.resize(points_.rows());
-        for (Eigen::Index i = 0; i < points_.rows(); ++i) d_[i] = surface->value(points_.row(i).transpose());
-      } else {
-        const distance::SignedDistance field(p);
-        feet_ = best_feet_;
-        field.evaluate(points_, d_, feet_, best_feet_.rows() == points_.rows());
-      }
+      feet_ = best_feet_;
+      residuals(p, kind_, points_, d_, feet_);
       f = d_.squaredNorm();
       if (!grad.empty()) gradient(p, grad);
     } catch (const InvalidParameter&) {
@@ -205,15 +271,7 @@ class ObjectiveFunction {
 
  private:
   void gradient(const ShapeParameters& p, std::vector<double>& grad) const {
-    Eigen::MatrixXd J;
-    VectorXd norms;
-    if (kind_ == Objective::Algebraic) {
-      parameterGradient(p, points_, J, norms);
-    } else {
-      parameterGradient(p, feet_, J, norms);
-      J.array().colwise() /= norms.array();
-    }
-    const VectorXd g = 2.0 * (J.transpose() * d_).cwiseProduct(scale_);
+    const VectorXd g = 2.0 * (residualJacobian(p, kind_, points_, feet_).transpose() * d_).cwiseProduct(scale_);
     std::copy(g.data(), g.data() + g.size(), grad.begin());
   }
 
@@ -239,6 +297,7 @@ std::string resultName(nlopt::result r) {
 
 struct RunResult {
   VectorXd x;
+  Eigen::MatrixX3d feet;  // closest points at x (geometric objective)
   double value = 0.0;
   int evaluations = 0;
   std::string termination;
@@ -246,11 +305,13 @@ struct RunResult {
 };
 
 // One NLopt run of `algorithm` from `start` within `bounds`, in variables
-// scaled by `steps`.
+// scaled by `steps`; `feet`: the closest points of the start if known (else
+// empty), warm starts for the first evaluation.
 RunResult runNlopt(nlopt::algorithm algorithm, ShapeModel model, const VectorXd& start, const Bounds& bounds,
-                   const VectorXd& steps, int max_evaluations, const Eigen::MatrixX3d& points, const Options& o) {
+                   const VectorXd& steps, int max_evaluations, const Eigen::MatrixX3d& points,
+                   const Eigen::MatrixX3d& feet, const Options& o) {
   const unsigned n = static_cast<unsigned>(start.size());
-  ObjectiveFunction objective(model, points, o.objective, start, steps);
+  ObjectiveFunction objective(model, points, o.objective, start, steps, feet);
   std::vector<double> x(n, 0.0), no_gradient;
   objective(x, no_gradient);  // the start is always a candidate
   const VectorXd lower = (bounds.lower - start).cwiseQuotient(steps);
@@ -279,9 +340,32 @@ RunResult runNlopt(nlopt::algorithm algorithm, ShapeModel model, const VectorXd&
     result.termination = std::string("NLopt stopped: ") + e.what();
   }
   result.x = objective.best_lambda;
+  result.feet = objective.bestFeet();
   result.value = objective.best_value;
   result.evaluations = objective.evaluations;
   return result;
+}
+
+// Levenberg-Marquardt on the residuals from `start` within `bounds`.
+RunResult runLevenbergMarquardt(ShapeModel model, const VectorXd& start, const Bounds& bounds, int max_evaluations,
+                                const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& feet, const Options& o) {
+  ResidualProblem problem(model, points, o.objective, feet);
+  LeastSquaresOptions lm;
+  lm.max_evaluations = max_evaluations;
+  lm.relative_tolerance = o.relative_tolerance;
+  lm.parameter_tolerance = o.parameter_tolerance;
+  lm.absolute_cost = 1e-20 * static_cast<double>(points.rows());
+  const LeastSquaresResult r = levenbergMarquardt(problem, start, bounds.lower, bounds.upper, lm);
+  return {r.x, problem.feet(), r.cost, r.evaluations, r.termination, r.converged};
+}
+
+// The local method of `o` from `start`: ours (LM) or NLopt's.
+RunResult runLocal(ShapeModel model, const VectorXd& start, const Bounds& bounds, const VectorXd& steps,
+                   int max_evaluations, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& feet,
+                   const Options& o) {
+  if (o.local_algorithm == kLevenbergMarquardt)
+    return runLevenbergMarquardt(model, start, bounds, max_evaluations, points, feet, o);
+  return runNlopt(localAlgorithm(o.local_algorithm), model, start, bounds, steps, max_evaluations, points, feet, o);
 }
 
 Bounds boundsForStart(Bounds b, ShapeModel model, const VectorXd& start) {
@@ -299,16 +383,96 @@ Bounds boundsForStart(Bounds b, ShapeModel model, const VectorXd& start) {
   return b;
 }
 
+// The ovoid's radius a and its coefficients c_jx enter the surface only
+// through the products a c_jx (the same for b and c_jy): (a, c) and
+// (k a, c / k) are one surface, an exact degeneracy along which local methods
+// crept for a hundred steps (measured on bench-fit). Holding a at its upper
+// bound loses no surface when each c_j range contains 0: the feasible
+// products a c_j, over all a <= a_max, are exactly a_max [lo_j, hi_j]. The
+// index of a (or b) and of c0..c3 of each axis, if it can be held.
+struct OvoidAxis {
+  Eigen::Index radius, c0;
+};
+std::vector<OvoidAxis> holdableOvoidAxes(ShapeModel model, const Bounds& b) {
+  std::vector<OvoidAxis> axes;
+  if (model != ShapeModel::Ovoid && model != ShapeModel::Superovoid) return axes;
+  const auto names = geometry::parameterNames(model);
+  auto index = [&](const std::string& n) {
+    return static_cast<Eigen::Index>(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  for (const char* axis : {"x", "y"}) {
+    const OvoidAxis a{index(axis[0] == 'x' ? "a" : "b"), index(std::string("c0") + axis)};
+    bool holdable = std::isfinite(b.upper[a.radius]) && b.upper[a.radius] > 0.0;
+    for (Eigen::Index j = a.c0; j < a.c0 + 4; ++j) holdable = holdable && b.lower[j] <= 0.0 && b.upper[j] >= 0.0;
+    if (holdable) axes.push_back(a);
+  }
+  return axes;
+}
+
+// A start of `model` as a vector with its bounds, the ovoid radii held (above).
+std::pair<VectorXd, Bounds> prepareStart(ShapeModel model, const ShapeParameters& start, const Bounds& model_bounds) {
+  VectorXd x0 = geometry::toVector(geometry::promote(start, model));
+  Bounds b = boundsForStart(model_bounds, model, x0);
+  for (const OvoidAxis& a : holdableOvoidAxes(model, b)) {
+    const double factor = x0[a.radius] / b.upper[a.radius];
+    x0.segment(a.c0, 4) *= factor;
+    x0[a.radius] = b.lower[a.radius] = b.upper[a.radius];
+  }
+  return {x0, b};
+}
+
+// The reverse for reporting: the smallest radius within the bounds that
+// keeps every c_j within its own (so c0 = 1 when c0 limits), same surface.
+ShapeParameters releaseOvoidScales(ShapeParameters p, const Bounds& model_bounds) {
+  const VectorXd x = geometry::toVector(p);
+  VectorXd out = x;
+  for (const OvoidAxis& a : holdableOvoidAxes(p.model, model_bounds)) {
+    double factor = model_bounds.lower[a.radius] / x[a.radius];
+    for (Eigen::Index j = a.c0; j < a.c0 + 4; ++j) {
+      if (x[j] > 0.0) factor = std::max(factor, x[j] / model_bounds.upper[j]);
+      if (x[j] < 0.0) factor = std::max(factor, x[j] / model_bounds.lower[j]);
+    }
+    if (!(factor > 0.0 && factor < 1.0)) continue;
+    out[a.radius] = x[a.radius] * factor;
+    out.segment(a.c0, 4) = (x.segment(a.c0, 4) / factor)  // the limiting c_j lands on its bound up to rounding
+                               .cwiseMax(model_bounds.lower.segment(a.c0, 4))
+                               .cwiseMin(model_bounds.upper.segment(a.c0, 4));
+  }
+  try {
+    return geometry::fromVector(p.model, out);
+  } catch (const InvalidParameter&) {
+    return p;  // e.g. bounds overridden beyond the valid set: keep the held form
+  }
+}
+
 ShapeParameters wrapAngles(ShapeParameters p) {
   // Normalise through the rotation matrix: same rotation, canonical angles.
   p.angles = geometry::anglesFromRotation(geometry::rotationFromAngles(p.angles));
   return p;
 }
 
-double rmsOf(const ShapeParameters& p, const Eigen::MatrixX3d& points, double& sse) {
-  sse = geometricObjective(p, points);
+// The RMS of the exact signed distances (the global closest points, into
+// `feet`), whatever the objective: what is reported and nested.
+double exactRms(const ShapeParameters& p, const Eigen::MatrixX3d& points, double& sse, Eigen::MatrixX3d& feet) {
+  VectorXd d;
+  distance::SignedDistance(p).evaluate(points, d, feet);
+  sse = d.squaredNorm();
   return std::sqrt(sse / static_cast<double>(points.rows()));
 }
+
+// A start of a model's fit; `feet`: its exact closest points if known (a
+// parent's optimum, the same surface), else empty.
+struct Start {
+  std::string label;
+  ShapeParameters shape;
+  Eigen::MatrixX3d feet;
+};
+
+// A model's fit and the exact closest points of its result (warm starts for its children).
+struct Fitted {
+  ModelFit fit;
+  Eigen::MatrixX3d feet;
+};
 
 // Every k-th point, about `target` of them (all if target is 0 or above
 // half the points): enough to rank starts at a fraction of the cost.
@@ -320,60 +484,72 @@ Eigen::MatrixX3d subsample(const Eigen::MatrixX3d& points, int target) {
   return out;
 }
 
-// Fits `model` from each start (label, parameters) and keeps the best.
+// Fits `model` from each start and keeps the best.
 // With `screen` > 0 and several starts, every start first gets `screen`
 // evaluations on a subsample of the points (Options::screening_points) and
-// only the best one is run to convergence on all of them.
-ModelFit fitModel(ShapeModel model, std::vector<std::pair<std::string, ShapeParameters>> starts,
-                  const Bounds& model_bounds, const Eigen::MatrixX3d& points, const Options& o, int screen = 0) {
+// only the best few (Options::screening_finalists; equal values count once)
+// are run to convergence on all of them.
+Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model_bounds,
+                const Eigen::MatrixX3d& points, const Options& o, int screen = 0) {
   const auto t0 = Clock::now();
-  const nlopt::algorithm local = localAlgorithm(o.local_algorithm);
-  ModelFit best;
+  Fitted fitted;
+  ModelFit& best = fitted.fit;
   double best_value = std::numeric_limits<double>::infinity();
   int screening_evaluations = 0;
+  std::string screened_labels;
   if (screen > 0 && starts.size() > 1) {
     Options short_run = o;
     short_run.max_evaluations = screen;
     short_run.strategy = Strategy::Local;
-    std::pair<std::string, ShapeParameters> winner;
+    std::vector<std::pair<double, Start>> screened;
     const Eigen::MatrixX3d screen_points = subsample(points, o.screening_points);
-    for (const auto& [label, start_shape] : starts) {
-      const ShapeParameters start = geometry::promote(start_shape, model);
-      const VectorXd x0 = geometry::toVector(start);
-      const RunResult r = runNlopt(local, model, x0, boundsForStart(model_bounds, model, x0),
-                                   initialSteps(model, start), screen, screen_points, short_run);
+    for (const Start& start : starts) {
+      const auto [x0, b] = prepareStart(model, start.shape, model_bounds);
+      const Eigen::MatrixX3d feet = start.feet.rows() == points.rows() ? subsample(start.feet, o.screening_points)
+                                                                         : Eigen::MatrixX3d();
+      const RunResult r =
+          runLocal(model, x0, b, initialSteps(model, start.shape), screen, screen_points, feet, short_run);
       screening_evaluations += r.evaluations;
-      if (r.value < best_value) {
-        best_value = r.value;
-        winner = {label, geometry::fromVector(model, r.x)};
-      }
+      if (std::isfinite(r.value)) screened.push_back({r.value, {start.label, geometry::fromVector(model, r.x), {}}});
     }
-    starts = {winner};
-    best_value = std::numeric_limits<double>::infinity();
+    // On a subsample, nearby optima can swap ranks (measured on bench-fit):
+    // finish the best few distinct ones.
+    std::stable_sort(screened.begin(), screened.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (!screened.empty()) {  // else (no valid start) every start is run as it is
+      for (const auto& s : starts) screened_labels += (screened_labels.empty() ? "" : ",") + s.label;
+      starts.clear();
+      for (size_t i = 0; i < screened.size() && static_cast<int>(starts.size()) < o.screening_finalists; ++i)
+        if (i == 0 || screened[i].first > screened[i - 1].first * (1.0 + 1e-9)) starts.push_back(screened[i].second);
+    }
   }
   best.evaluations = screening_evaluations;
-  for (const auto& [label, start_shape] : starts) {
-    const ShapeParameters start = geometry::promote(start_shape, model);
-    const VectorXd x0 = geometry::toVector(start);
-    const Bounds b = boundsForStart(model_bounds, model, x0);
-    const VectorXd steps = initialSteps(model, start);
+  for (const Start& start : starts) {
+    const auto [x0, b] = prepareStart(model, start.shape, model_bounds);
+    const VectorXd steps = initialSteps(model, start.shape);
     RunResult run;
     int evaluations = 0;
     std::string how;
-    if (o.strategy == Strategy::GlobalLocal && model != ShapeModel::Sphere) {
+    // The global search explores the whole box: once per model is enough
+    // (from the best screened start).
+    const bool search_globally = o.strategy == Strategy::GlobalLocal && model != ShapeModel::Sphere &&
+                                 (screened_labels.empty() || &start == &starts.front());
+    if (search_globally) {
       const RunResult global =
-          runNlopt(nlopt::GN_CRS2_LM, model, x0, b, steps, o.global_evaluations, points, o);
+          runNlopt(nlopt::GN_CRS2_LM, model, x0, b, steps, o.global_evaluations, points, start.feet, o);
       evaluations += global.evaluations;
       how = "GN_CRS2_LM (" + global.termination + ") then ";
-      run = runNlopt(local, model, global.x, b, steps, o.max_evaluations, points, o);
+      run = runLocal(model, global.x, b, steps, o.max_evaluations, points, global.feet, o);
     } else {
-      run = runNlopt(local, model, x0, b, steps, o.max_evaluations, points, o);
+      run = runLocal(model, x0, b, steps, o.max_evaluations, points, start.feet, o);
     }
     evaluations += run.evaluations;
-    // SLSQP's objective test can stop on a short step while still descending:
-    // restart (a fresh quasi-Newton model) while that still gains.
+    // A run can stop on a short step while still descending (SLSQP's
+    // objective test; LM after heavy damping): restart (a fresh quasi-Newton
+    // model or damping) while that still gains. With LM this costs 2-3
+    // evaluations per model.
     for (int restart = 0; restart < o.restarts; ++restart) {
-      const RunResult again = runNlopt(local, model, run.x, b, steps, o.max_evaluations, points, o);
+      const RunResult again = runLocal(model, run.x, b, steps, o.max_evaluations, points, run.feet, o);
       evaluations += again.evaluations;
       const bool gained = again.value < run.value * (1.0 - 1e-6) && again.value > 1e-20 * static_cast<double>(points.rows());
       if (again.value < run.value) run = again;
@@ -382,29 +558,33 @@ ModelFit fitModel(ShapeModel model, std::vector<std::pair<std::string, ShapePara
     best.evaluations += evaluations;
     if (run.value < best_value) {
       best_value = run.value;
-      best.parameters = wrapAngles(geometry::fromVector(model, run.x));
+      best.parameters = wrapAngles(releaseOvoidScales(geometry::fromVector(model, run.x), model_bounds));
       best.termination = how + o.local_algorithm + ": " + run.termination;
       best.converged = run.converged;
-      best.started_from = label;
+      best.started_from = start.label;
     }
   }
-  if (starts.size() > 1) {
+  if (!screened_labels.empty()) {
+    best.started_from += " (screened: " + screened_labels + ")";
+  } else if (starts.size() > 1) {
     std::string all;
-    for (const auto& s : starts) all += (all.empty() ? "" : ",") + s.first;
+    for (const Start& s : starts) all += (all.empty() ? "" : ",") + s.label;
     best.started_from += " (best of " + all + ")";
   }
-  best.rms_mm = rmsOf(best.parameters, points, best.sse_mm2);
+  best.rms_mm = exactRms(best.parameters, points, best.sse_mm2, fitted.feet);
   best.algebraic_objective = algebraicObjective(best.parameters, points);
   best.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  return best;
+  return fitted;
 }
 
-// The six labellings of an ellipsoid's axes with a right-handed frame (local
-// z along each axis, either way): the same surface, but distinct starts for
-// the ovoid, whose asymmetry runs along local z (c1 >= 0: wider towards +z).
-std::vector<std::pair<std::string, ShapeParameters>> axisLabellings(const ShapeParameters& e) {
+// The six labellings of an ellipsoid's or a superellipsoid's axes with a
+// right-handed frame (local z along each axis, either way): the same surface,
+// but distinct starts for the ovoid and superovoid, whose asymmetry runs
+// along local z (c1 >= 0: wider towards +z).
+std::vector<Start> axisLabellings(const Fitted& parent) {
+  const ShapeParameters& e = parent.fit.parameters;
   const Eigen::Matrix3d R = geometry::rotationFromAngles(e.angles);
-  std::vector<std::pair<std::string, ShapeParameters>> out;
+  std::vector<Start> out;
   for (int k = 2; k < 5; ++k)
     for (double sign : {1.0, -1.0}) {
       const int iz = k % 3, ix = (k + 1) % 3, iy = (k + 2) % 3;
@@ -414,8 +594,9 @@ std::vector<std::pair<std::string, ShapeParameters>> axisLabellings(const ShapeP
       L.col(1) = L.col(2).cross(L.col(0));
       ShapeParameters p = e;
       p.radii = Eigen::Vector3d(e.radii[ix], e.radii[iy], e.radii[iz]);
+      p.exponents = Eigen::Vector3d(e.exponents[ix], e.exponents[iy], e.exponents[iz]);
       p.angles = geometry::anglesFromRotation(L);
-      out.emplace_back(std::string("ellipsoid (z = ") + (sign > 0 ? "+" : "-") + "xyz"[iz] + ")", p);
+      out.push_back({geometry::modelName(e.model) + " (z = " + (sign > 0 ? "+" : "-") + "xyz"[iz] + ")", p, parent.feet});
     }
   return out;
 }
@@ -437,11 +618,13 @@ ShapeParameters combineParents(const ShapeParameters& superellipsoid, const Shap
 }
 
 // The nesting guarantee: a child never reports a worse RMS than its parent.
-void enforceNesting(ModelFit& child, const ModelFit& parent, const Eigen::MatrixX3d& points) {
+void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::MatrixX3d& points) {
+  ModelFit& child = fitted.fit;
+  const ModelFit& parent = parent_fitted.fit;
   if (child.rms_mm <= parent.rms_mm) return;
   const ShapeModel model = child.parameters.model;
   child.parameters = geometry::promote(parent.parameters, model);
-  child.rms_mm = rmsOf(child.parameters, points, child.sse_mm2);
+  child.rms_mm = exactRms(child.parameters, points, child.sse_mm2, fitted.feet);
   child.algebraic_objective = algebraicObjective(child.parameters, points);
   child.termination += "; kept the " + geometry::modelName(parent.parameters.model) + " (fit was not better)";
 }
@@ -494,42 +677,44 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   }
 
   auto bounds = [&](ShapeModel m) { return makeBounds(m, ellipsoid_start, sphere_start, o); };
-  const ModelFit sphere = fitModel(ShapeModel::Sphere, {{"algebraic", sphere_start}}, bounds(ShapeModel::Sphere),
-                                   points, o);
-  std::vector<std::pair<std::string, ShapeParameters>> e_starts{{"sphere", sphere.parameters}};
-  if (have_algebraic_ellipsoid) e_starts.emplace_back("algebraic", ellipsoid_start);
-  ModelFit ellipsoid =
+  const Fitted sphere = fitModel(ShapeModel::Sphere, {{"algebraic", sphere_start, {}}}, bounds(ShapeModel::Sphere),
+                                 points, o);
+  std::vector<Start> e_starts{{"sphere", sphere.fit.parameters, sphere.feet}};
+  if (have_algebraic_ellipsoid) e_starts.push_back({"algebraic", ellipsoid_start, {}});
+  Fitted ellipsoid =
       fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o, o.screening_evaluations);
   enforceNesting(ellipsoid, sphere, points);
 
   auto wanted = [&](ShapeModel m) { return std::find(o.models.begin(), o.models.end(), m) != o.models.end(); };
   const bool need_se = wanted(ShapeModel::Superellipsoid) || wanted(ShapeModel::Superovoid);
   const bool need_o = wanted(ShapeModel::Ovoid) || wanted(ShapeModel::Superovoid);
-  ModelFit superellipsoid, ovoid, superovoid;
+  Fitted superellipsoid, ovoid, superovoid;
   if (need_se) {
-    superellipsoid = fitModel(ShapeModel::Superellipsoid, {{"ellipsoid", ellipsoid.parameters}},
+    superellipsoid = fitModel(ShapeModel::Superellipsoid, {{"ellipsoid", ellipsoid.fit.parameters, ellipsoid.feet}},
                               bounds(ShapeModel::Superellipsoid), points, o);
     enforceNesting(superellipsoid, ellipsoid, points);
   }
   if (need_o) {
-    ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(ellipsoid.parameters), bounds(ShapeModel::Ovoid), points, o,
+    ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(ellipsoid), bounds(ShapeModel::Ovoid), points, o,
                      o.screening_evaluations);
     enforceNesting(ovoid, ellipsoid, points);
   }
   if (wanted(ShapeModel::Superovoid)) {
-    superovoid = fitModel(ShapeModel::Superovoid,
-                          {{"superellipsoid", superellipsoid.parameters},
-                           {"ovoid", ovoid.parameters},
-                           {"ovoid with the superellipsoid's exponents",
-                            combineParents(superellipsoid.parameters, ovoid.parameters)}},
-                          bounds(ShapeModel::Superovoid), points, o, o.screening_evaluations);
-    enforceNesting(superovoid, superellipsoid.rms_mm <= ovoid.rms_mm ? superellipsoid : ovoid, points);
+    // Every labelling of the superellipsoid: which axis the asymmetry takes
+    // decided the optimum reached on the real femoral head (measured).
+    std::vector<Start> so_starts = axisLabellings(superellipsoid);
+    so_starts.push_back({"ovoid", ovoid.fit.parameters, ovoid.feet});
+    so_starts.push_back({"ovoid with the superellipsoid's exponents",
+                         combineParents(superellipsoid.fit.parameters, ovoid.fit.parameters), {}});
+    superovoid = fitModel(ShapeModel::Superovoid, so_starts, bounds(ShapeModel::Superovoid), points, o,
+                          o.screening_evaluations);
+    enforceNesting(superovoid, superellipsoid.fit.rms_mm <= ovoid.fit.rms_mm ? superellipsoid : ovoid, points);
   }
 
   Summary summary;
   summary.points = static_cast<int>(points.rows());
-  for (const ModelFit* f : std::initializer_list<const ModelFit*>{&sphere, &ellipsoid, &superellipsoid, &ovoid, &superovoid})
-    if (wanted(f->parameters.model) && f->evaluations > 0) summary.fits.push_back(*f);
+  for (const Fitted* f : std::initializer_list<const Fitted*>{&sphere, &ellipsoid, &superellipsoid, &ovoid, &superovoid})
+    if (wanted(f->fit.parameters.model) && f->fit.evaluations > 0) summary.fits.push_back(f->fit);
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)
     if (f.rms_mm < best_rms - 1e-9) {

@@ -1,8 +1,16 @@
 #pragma once
 // Fitting the hierarchy sphere -> ellipsoid -> {superellipsoid, ovoid} ->
-// superovoid (thesis fig. 3.2) to a point cloud with NLopt, Ceres-style:
-// an Options struct validated before use and a Summary with the
-// termination reason of every model.
+// superovoid (thesis fig. 3.2) to a point cloud, Ceres-style: an Options
+// struct validated before use and a Summary with the termination reason of
+// every model.
+//
+// The local method, chosen by measurement (docs/benchmarks.md, bench-fit):
+// Levenberg-Marquardt on the residuals themselves (orthogonal distance
+// fitting, Ahn 2004: the Jacobian of the signed distances is dF/dlambda /
+// |grad F| at the closest points), about 3x faster than NLopt's best
+// (LD_SLSQP on the summed squares) to the same optima. NLopt stays for the
+// optional global search (GN_CRS2_LM, Strategy::GlobalLocal) and as the
+// alternative local methods.
 //
 // Every child starts at its parent's optimum (which it contains exactly) and
 // keeps the best point it evaluates, so each model's RMS signed Euclidean
@@ -38,13 +46,14 @@ struct Options {
   std::vector<geometry::ShapeModel> models = geometry::allModels();  // what to report (ancestors are fitted anyway)
   Objective objective = Objective::Geometric;
   Strategy strategy = Strategy::Local;
-  std::string local_algorithm = "LD_SLSQP";  // or LN_BOBYQA, LD_LBFGS, LD_MMA, LD_TNEWTON_PRECOND_RESTART
+  std::string local_algorithm = "LM";  // Levenberg-Marquardt (ours); or NLopt LD_SLSQP, LN_BOBYQA, LD_LBFGS, ...
   unsigned seed = 42;                  // NLopt's random seed (CRS2)
   int max_evaluations = 4000;          // per local run
   int global_evaluations = 3000;       // per global run (GlobalLocal)
   int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
   int screening_evaluations = 40;      // models with several starts: evaluations per start before the best is finished
   int screening_points = 400;          // screen the starts on about this many of the points (every k-th; 0 = all)
+  int screening_finalists = 3;         // then finish this many of the best (distinct) on all points
   double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
   double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
   // Bounds (thesis section 3.2.5), around the reference ellipsoid start:
