@@ -183,11 +183,16 @@ class ContactCommand : public cli::Command {
     app.add_option("--steps", steps_, "Steps of a --scenario")->check(CLI::Range(1, 1000000))->capture_default_str();
     app.add_option("--frame", frame_, "Tangent frame: householder or square-plate")
         ->check(CLI::IsMember({"householder", "square-plate"}))->capture_default_str();
+    app.add_option("--solver", solver_,
+                   "Ellipsoid pairs: auto (Newton on the support-function dual) or common-normal (eq. 5.23, "
+                   "the thesis solver; other pairs always use it)")
+        ->check(CLI::IsMember({"auto", "common-normal"}))->capture_default_str();
     app.add_option("-o,--output", output_, "Output CSV")->required();
   }
 
   int run(const cli::CommonOptions& common) override {
     options_.frame = frame_ == "householder" ? geometry::FrameMethod::Householder : geometry::FrameMethod::SquarePlate;
+    options_.solver = solver_ == "auto" ? contact::ContactSolver::Auto : contact::ContactSolver::CommonNormal;
     options_.validate();
     if (pairs_.empty() && scenario_.empty() && fits_a_.empty())
       throw UsageError("expected one of --pairs, --scenario or --fits-a/--fits-b");
@@ -301,7 +306,7 @@ class ContactCommand : public cli::Command {
     nlohmann::json summary = {{"output", output_.string()},
                               {"scenario", scenario_},
                               {"steps", steps_},
-                              {"frame", frame_},
+                              {"frame", frame_}, {"solver", solver_},
                               {"converged_steps", converged},
                               {"iterations_per_warm_step", steps_ > 1 ? static_cast<double>(iterations) / (steps_ - 1) : 0.0},
                               {"max_iterations_per_step", max_iterations},
@@ -344,7 +349,7 @@ class ContactCommand : public cli::Command {
   void finish(nlohmann::json& summary, const cli::CommonOptions& common, std::vector<std::filesystem::path> inputs) {
     summary["coordinate_system"] = "LPS";
     summary["units"] = "mm";
-    const nlohmann::json params = {{"frame", frame_},
+    const nlohmann::json params = {{"frame", frame_}, {"solver", solver_},
                                    {"max_iterations", options_.max_iterations},
                                    {"step_tolerance", options_.step_tolerance},
                                    {"sample_directions", options_.sample_directions},
@@ -356,7 +361,7 @@ class ContactCommand : public cli::Command {
   }
 
   std::filesystem::path pairs_, output_, fits_a_, fits_b_;
-  std::string scenario_, model_a_, model_b_, frame_ = "householder";
+  std::string scenario_, model_a_, model_b_, frame_ = "householder", solver_ = "auto";
   std::vector<double> pose_a_, pose_b_;
   int steps_ = 200;
   contact::ContactOptions options_;

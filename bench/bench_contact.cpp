@@ -12,7 +12,10 @@
 // no answer), answered (pairs the method gave a distance for).
 // Peers: Simbody's ContactTracker::ConvexImplicitPair (the same six equations,
 // reports overlap only), libccd GJK+EPA and MPR (penetration only; an exact
-// ellipsoid support function).
+// ellipsoid support function), FCL's fcl::distance with signed distance
+// (its Ellipsoid shape, libccd GJK/EPA inside, tolerance 1e-6: Debian's build
+// asserts at tighter ones) and Bullet's btGjkEpaSolver2::SignedDistance in
+// double precision (an exact ellipsoid support function, margin 0).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,9 +24,13 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <BulletCollision/CollisionShapes/btConvexInternalShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
 #include <Simbody.h>
 #include <benchmark/benchmark.h>
 #include <ccd/ccd.h>
+#include <fcl/geometry/shape/ellipsoid.h>
+#include <fcl/narrowphase/distance.h>
 
 #include "articula/contact/common_normal.hpp"
 #include "articula/contact/plane_contact.hpp"
@@ -194,6 +201,69 @@ void BM_Libccd(benchmark::State& state) {
 void BM_LibccdGjkEpa(benchmark::State& state) { BM_Libccd<ccdGJKPenetration>(state); }
 void BM_LibccdMpr(benchmark::State& state) { BM_Libccd<ccdMPRPenetration>(state); }
 
+// ---------------------------------------------------------------- FCL
+void BM_Fcl(benchmark::State& state) {
+  fcl::DistanceRequestd request;
+  request.enable_signed_distance = true;
+  request.enable_nearest_points = true;
+  request.distance_tolerance = 1e-6;  // Debian's FCL asserts at tighter tolerances
+  request.gjk_solver_type = fcl::GST_LIBCCD;
+  auto transform = [](const ConvexShape& s) {
+    fcl::Transform3d t = fcl::Transform3d::Identity();
+    t.linear() = s.rotation;
+    t.translation() = s.center;
+    return t;
+  };
+  runMethod(state, [&](const Pair& p) -> double {
+    const fcl::Ellipsoidd ea(p.a.radii), eb(p.b.radii);
+    fcl::DistanceResultd result;
+    fcl::distance(&ea, transform(p.a), &eb, transform(p.b), request, result);
+    return result.min_distance;
+  });
+}
+
+// ---------------------------------------------------------------- Bullet (double precision)
+// An ellipsoid with the exact support mapping x = D^2 v / |D v| (local axes), margin 0.
+class BulletEllipsoid : public btConvexInternalShape {
+ public:
+  explicit BulletEllipsoid(const Vector3d& radii) : radii_(radii) { setMargin(0.0); }
+  btVector3 localGetSupportingVertexWithoutMargin(const btVector3& v) const override {
+    const Vector3d w = radii_.cwiseProduct(Vector3d(v.x(), v.y(), v.z()));
+    const double len = w.norm();
+    if (!(len > 0.0)) return btVector3(radii_[0], 0.0, 0.0);
+    const Vector3d x = radii_.cwiseProduct(w) / len;
+    return btVector3(x[0], x[1], x[2]);
+  }
+  btVector3 localGetSupportingVertex(const btVector3& v) const override {
+    return localGetSupportingVertexWithoutMargin(v);
+  }
+  void batchedUnitVectorGetSupportingVertexWithoutMargin(const btVector3* v, btVector3* out, int n) const override {
+    for (int i = 0; i < n; ++i) out[i] = localGetSupportingVertexWithoutMargin(v[i]);
+  }
+  void getAabb(const btTransform& t, btVector3& lo, btVector3& hi) const override { getAabbSlow(t, lo, hi); }
+  void calculateLocalInertia(btScalar, btVector3& inertia) const override { inertia.setZero(); }
+  const char* getName() const override { return "ArticulaEllipsoid"; }
+
+ private:
+  Vector3d radii_;
+};
+void BM_Bullet(benchmark::State& state) {
+  auto transform = [](const ConvexShape& s) {
+    const Eigen::Matrix3d& R = s.rotation;
+    return btTransform(btMatrix3x3(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
+                       btVector3(s.center[0], s.center[1], s.center[2]));
+  };
+  runMethod(state, [&](const Pair& p) -> double {
+    const BulletEllipsoid ea(p.a.radii), eb(p.b.radii);
+    btGjkEpaSolver2::sResults results;
+    const Vector3d guess = p.b.center - p.a.center;
+    // Distance (GJK) when separated, else Penetration (EPA): distance < 0.
+    const bool ok = btGjkEpaSolver2::SignedDistance(&ea, transform(p.a), &eb, transform(p.b),
+                                                    btVector3(guess[0], guess[1], guess[2]), results);
+    return ok ? static_cast<double>(results.distance) : NAN;
+  });
+}
+
 // ---------------------------------------------------------------- superellipsoid-plane
 // Closed form (support mapping, 1-D root find for unequal exponents 2-4).
 // Counters: max |F| at the answer and max (1 - n_shape . (-n_plane)), i.e.
@@ -240,6 +310,8 @@ BENCHMARK(BM_OursWarm)->Apply(classes);
 BENCHMARK(BM_Simbody)->Apply(classes);
 BENCHMARK(BM_LibccdGjkEpa)->Apply(classes);
 BENCHMARK(BM_LibccdMpr)->Apply(classes);
+BENCHMARK(BM_Fcl)->Apply(classes);
+BENCHMARK(BM_Bullet)->Apply(classes);
 
 }  // namespace
 

@@ -41,6 +41,12 @@ grep -q 'bad.csv:2:' "$ARTICULA_TMP/bad.err"
 grep -q '"converged_steps": 200' "$ARTICULA_TMP/motion.json"
 [ "$(wc -l < "$ARTICULA_TMP/motion.csv")" -eq 201 ]
 awk -F'[:,]' '/iterations_per_warm_step/ { exit !($2 < 8) }' "$ARTICULA_TMP/motion.json"
+# The same motion with the thesis' common-normal solver: same distances.
+"$bin" contact --scenario table5.3-3 --solver common-normal -o "$ARTICULA_TMP/motion_cn.csv" --force --json -q \
+  > "$ARTICULA_TMP/motion_cn.json"
+grep -q '"converged_steps": 200' "$ARTICULA_TMP/motion_cn.json"
+paste -d, "$ARTICULA_TMP/motion.csv" "$ARTICULA_TMP/motion_cn.csv" | awk -F, -v n="$(head -1 "$ARTICULA_TMP/motion.csv" | tr , '\n' | wc -l)" \
+  'NR > 1 { d = $2 - $(n + 2); if (d < 0) d = -d; if (d > 1e-10) { print "step " $1 ": " $2 " vs " $(n + 2); bad = 1 } } END { exit bad }'
 echo "contact app: OK"
 
 # Two fitted surfaces: the head ellipsoid (rotated 90 deg about z: extent 22 mm

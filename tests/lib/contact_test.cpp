@@ -321,18 +321,30 @@ TEST(Contact, SymmetricConfigurationsWithSeveralSolutions) {
   EXPECT_NEAR(computeContact(sphere, inner).distance, -2.0, 1e-12);
 }
 
-TEST(Contact, HouseholderAndSquarePlateAgree) {
-  std::mt19937_64 rng(10);
-  std::uniform_real_distribution<double> gap(-0.3, 0.5);
-  ContactOptions sp;
-  sp.frame = FrameMethod::SquarePlate;
+// Random pairs placed with a gap in [gap_min, gap_max]: `other` gives the same
+// answers as the default options (and both match the reference for ellipsoids).
+void expectSameAnswers(const ContactOptions& other, unsigned seed, double r_min, double g_max, double gap_min,
+                       double gap_max) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> gap(gap_min, gap_max);
   for (int i = 0; i < 40; ++i) {
-    ConvexShape a = randomShape(rng, 0.5, 1.5, 3.0), b = randomShape(rng, 0.5, 1.5, 3.0);
+    ConvexShape a = randomShape(rng, r_min, 1.5, g_max), b = randomShape(rng, r_min, 1.5, g_max);
     placeAt(a, b, rng, gap(rng));
-    const ContactResult h = computeContact(a, b), s = computeContact(a, b, sp);
-    EXPECT_NEAR(h.distance, s.distance, 1e-10);
-    EXPECT_LT((h.point_a - s.point_a).norm(), 1e-6);
+    const ContactResult d = computeContact(a, b), o = computeContact(a, b, other);
+    EXPECT_NEAR(d.distance, o.distance, 1e-10) << "pair " << i << ": " << o.summary.briefReport();
+    if (d.distance > 0.0 || g_max > 2.0) {  // unique points when separated (and on these superellipsoid pairs)
+      EXPECT_LT((d.point_a - o.point_a).norm(), 1e-6);
+    }
+    if (g_max == 2.0) {
+      EXPECT_NEAR(d.distance, referenceDistance(a, b), 1e-10) << "pair " << i;
+    }
   }
+}
+
+TEST(Contact, HouseholderAndSquarePlateAgree) {
+  ContactOptions square_plate;
+  square_plate.frame = FrameMethod::SquarePlate;
+  expectSameAnswers(square_plate, 10, 0.5, 3.0, -0.3, 0.5);
 }
 
 TEST(Contact, WarmStartsFollowAMotion) {
@@ -352,6 +364,74 @@ TEST(Contact, WarmStartsFollowAMotion) {
     previous = warm;
   }
   EXPECT_LT(total_iterations / 199.0, 6.0);
+}
+
+TEST(Contact, CommonNormalSolverAgreesOnEllipsoids) {
+  // Ellipsoid pairs normally take the dual Newton path; the thesis'
+  // common-normal system of eq. 5.23 must give the same answers.
+  ContactOptions common_normal;
+  common_normal.solver = ContactSolver::CommonNormal;
+  expectSameAnswers(common_normal, 12, 0.3, 2.0, -0.5, 0.5);
+  const ConvexShape a = makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 2, 3));
+  const ConvexShape b = makeConvexShape(Vector3d(1.5, 0, 0), Matrix3d::Identity(), Vector3d(1, 1, 1));
+  // Overlap: only the dual path searches globally and tracks rivals.
+  EXPECT_EQ(computeContact(a, b, common_normal).rival_count, -1);
+  EXPECT_GE(computeContact(a, b).rival_count, 0);
+  EXPECT_NEAR(computeContact(a, b).distance, -0.5, 1e-12);
+}
+
+TEST(Contact, WarmStartsOnDeepOverlapsFindTheGlobalAnswer) {
+  // Deep, high-aspect pairs: several local maxima of the dual. A warm start
+  // from the pair one small step earlier must still end at the global answer.
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> gap(-1.0, -0.1);
+  for (int i = 0; i < 60; ++i) {
+    ConvexShape a = randomShape(rng, 0.15, 1.5), b = randomShape(rng, 0.15, 1.5);
+    placeAt(a, b, rng, gap(rng));
+    ConvexShape before = b;
+    before.center += 0.02 * Vector3d(g(rng), g(rng), g(rng)).normalized();
+    before.rotation = Eigen::AngleAxisd(0.02, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+    const ContactResult previous = computeContact(a, before);
+    const ContactResult warm = computeContact(a, b, {}, &previous);
+    EXPECT_NEAR(warm.distance, referenceDistance(a, b), 1e-10) << "pair " << i << ": " << warm.summary.briefReport();
+  }
+}
+
+TEST(Frames, VaryContinuouslyAlongASmoothMotion) {
+  // Table 5.3-3 motion, 2,000 steps: the contact normal moves a little per
+  // step, and each tangent frame moves no more than its derivative allows
+  // (|dt| <= |dt/dn| |dn|), except where the normal crosses the frame's
+  // branch plane (Householder: n_x = 0; square plate: n_x n_y = 0).
+  const int steps = 2000;
+  ContactResult previous;
+  Vector3d n_prev = Vector3d::Zero();
+  int checked = 0;
+  for (int k = 0; k < steps; ++k) {
+    const ScenarioPair p = scenarioPair("table5.3-3", k, steps);
+    const ContactResult r = computeContact(p.i, p.j, {}, k ? &previous : nullptr);
+    const Vector3d n = r.normal;
+    if (k) {
+      const double dn = (n - n_prev).norm();
+      EXPECT_LT(dn, 0.05) << "the normal jumps at step " << k;
+      for (FrameMethod m : {FrameMethod::Householder, FrameMethod::SquarePlate}) {
+        const bool householder = m == FrameMethod::Householder;
+        const bool crossed = householder ? (n.x() > 0) != (n_prev.x() > 0)
+                                         : (n.x() * n.y() >= 0) != (n_prev.x() * n_prev.y() >= 0);
+        if (crossed) continue;
+        const FrameWithDerivatives f = frameWithDerivatives(n, m), f_prev = frameWithDerivatives(n_prev, m);
+        const double slope_t = std::max(f.dt_dn.norm(), f_prev.dt_dn.norm());
+        const double slope_b = std::max(f.db_dn.norm(), f_prev.db_dn.norm());
+        EXPECT_LE((f.t - f_prev.t).norm(), 1.1 * slope_t * dn + 1e-12) << "step " << k;
+        EXPECT_LE((f.b - f_prev.b).norm(), 1.1 * slope_b * dn + 1e-12) << "step " << k;
+        EXPECT_NEAR(f.t.cross(f.b).dot(n), 1.0, 1e-12);
+        ++checked;
+      }
+    }
+    previous = r;
+    n_prev = n;
+  }
+  EXPECT_GT(checked, 3 * steps / 2);
 }
 
 TEST(Contact, OptionsAreValidated) {

@@ -8,6 +8,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "articula/contact/ellipsoid_contact.hpp"
 #include "articula/contact/frame_derivatives.hpp"
 #include "articula/core/error.hpp"
 
@@ -288,8 +289,10 @@ struct Solver {
 ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const ContactOptions& options,
                              const ContactResult* warm_start) {
   options.validate();
+  if (options.solver == ContactSolver::Auto && a.quadric && b.quadric) return ellipsoidContact(a, b, options, warm_start);
   ContactResult result;
   ContactSummary& summary = result.summary;
+  bool hill_climb_answer = false;
   Solver solver{a, b, options, std::max(boundingRadius(a), boundingRadius(b)), summary};
 
   double distance = 0.0;
@@ -336,15 +339,15 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
         solver.best = s_climb;
         solver.best_ua = ua;
         solver.best_ub = ub;
-        summary.status = ContactStatus::NotConverged;
+        hill_climb_answer = true;
         summary.termination = "no Newton start converged to the dual maximum; dual hill climb answer";
       }
     }
-    if (summary.termination.empty())
+    if (!summary.termination)
       summary.termination = solver.best > 0.0 ? "separated (dual certificate, after global search)"
                                               : "overlap: best of the global search";
   }
-  if (summary.termination.rfind("no Newton", 0) != 0) summary.status = ContactStatus::Converged;
+  if (!hill_climb_answer) summary.status = ContactStatus::Converged;
 
   result.canonical_a = solver.best_ua;
   result.canonical_b = solver.best_ub;

@@ -70,35 +70,46 @@ Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
   if (s.quadric) return w / w.norm();
   // Lagrange: w_i = lambda g_i |u_i|^(g_i-1) sgn(u_i), so with mu = 1/lambda,
   // a_i = |w_i| / g_i and p_i = g_i / (g_i - 1): |u_i| = (mu a_i)^(p_i - 1),
-  // and F = 0 reads S(t) = sum_i exp(p_i (t + log a_i)) = 1 at t = log mu.
-  // log S is convex and increasing in t: Newton from a start with S >= 1
-  // decreases monotonically onto the root.
-  double log_a[3], p[3];
+  // and F = 0 reads S(t) = sum_i exp(p_i x_i) = 1 with x_i = t + log a_i, t = log mu.
+  // Start: with x_i <= 0 near the root, exp(p_i x_i) >= exp(p_max x_i), so
+  // the root of sum_i exp(p_max x_i) = 1 lies right of the root (S >= 1 there).
+  double a[3], log_a[3], p[3];
   bool active[3];
-  double log_a_max = -INFINITY;
+  double p_max = 0.0, log_a_max = -INFINITY;
   for (int i = 0; i < 3; ++i) {
     active[i] = w[i] != 0.0;
-    log_a[i] = active[i] ? std::log(std::fabs(w[i]) / s.exponents[i]) : 0.0;
+    a[i] = std::fabs(w[i]) / s.exponents[i];
+    log_a[i] = active[i] ? std::log(a[i]) : 0.0;
     p[i] = s.exponents[i] / (s.exponents[i] - 1.0);
-    if (active[i]) log_a_max = std::max(log_a_max, log_a[i]);
+    if (active[i]) p_max = std::max(p_max, p[i]), log_a_max = std::max(log_a_max, log_a[i]);
   }
-  double t = -log_a_max;  // the largest term is 1 here, so S >= 1
+  double sum = 0.0;
+  for (int i = 0; i < 3; ++i)
+    if (active[i]) sum += std::exp(p_max * (log_a[i] - log_a_max));
+  double t = -log_a_max - std::log(sum) / p_max;
+  // Halley's method on f = log S (f' = mean of p_i weighted by the terms, f''
+  // their variance <= 1/4): cubic convergence, so a step under 1e-6 leaves the
+  // error at rounding; plain Newton if Halley's denominator is not positive.
   for (int iteration = 0; iteration < 60; ++iteration) {
-    double S = 0.0, dS = 0.0;
+    double S = 0.0, dS = 0.0, d2S = 0.0;
     for (int i = 0; i < 3; ++i) {
       if (!active[i]) continue;
       const double term = std::exp(p[i] * (t + log_a[i]));
       S += term;
       dS += p[i] * term;
+      d2S += p[i] * p[i] * term;
     }
-    const double log_S = std::log(S);
-    const double step = log_S * S / dS;
+    const double f = std::log(S), f1 = dS / S, f2 = d2S / S - f1 * f1;
+    const double denominator = 2.0 * f1 * f1 - f * f2;
+    const double step = denominator > 0.0 ? 2.0 * f * f1 / denominator : f / f1;
     t -= step;
-    if (std::fabs(step) <= 1e-15 * (1.0 + std::fabs(t))) break;
+    if (std::fabs(step) <= 1e-6 * (1.0 + std::fabs(t))) break;
   }
+  // |u_i| = exp((p_i - 1) x_i) = exp(p_i x_i) / (a_i e^t), with exp(p_i x_i) at the final t.
+  const double mu = std::exp(t);
   Vector3d u = Vector3d::Zero();
   for (int i = 0; i < 3; ++i)
-    if (active[i]) u[i] = std::copysign(std::exp((p[i] - 1.0) * (t + log_a[i])), w[i]);
+    if (active[i]) u[i] = std::copysign(std::exp(p[i] * (t + log_a[i])) / (a[i] * mu), w[i]);
   return u;
 }
 

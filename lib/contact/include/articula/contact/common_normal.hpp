@@ -30,8 +30,15 @@
 
 namespace articula::contact {
 
+/// Which formulation solves a pair of ellipsoids (other pairs always use the common-normal system).
+enum class ContactSolver {
+  Auto,          // ellipsoid pairs: Newton on the support-function dual (ellipsoid_contact.hpp)
+  CommonNormal,  // always the common-normal system of eq. 5.23 (thesis behaviour, e.g. to compare frames)
+};
+
 struct ContactOptions {
-  geometry::FrameMethod frame = geometry::FrameMethod::Householder;  // or SquarePlate
+  ContactSolver solver = ContactSolver::Auto;
+  geometry::FrameMethod frame = geometry::FrameMethod::Householder;  // or SquarePlate (common-normal system)
   int max_iterations = 40;          // Newton iterations per start
   double step_tolerance = 1e-13;    // stop when |delta u| (canonical, dimensionless) is below
   double residual_tolerance = 1e-14;  // or when |Phi| (dimensionless) is below
@@ -50,7 +57,7 @@ const char* statusName(ContactStatus status);  // "converged", "not_converged"
 
 struct ContactSummary {
   ContactStatus status = ContactStatus::NotConverged;
-  std::string termination;   // why the solver stopped, in words
+  const char* termination = nullptr;  // why the solver stopped, in words (static string)
   int iterations = 0;        // Newton iterations over every start
   int starts = 0;            // Newton starts
   int damped_steps = 0;      // Levenberg-Marquardt steps (singular Jacobian or rejected Newton step)
@@ -68,11 +75,18 @@ struct ContactResult {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();        // unit outward normal of A at point_a
   Eigen::Vector3d canonical_a = Eigen::Vector3d::UnitX();   // u_A: warm start of the next call
   Eigen::Vector3d canonical_b = -Eigen::Vector3d::UnitX();  // u_B
+  // Overlapping ellipsoids: normals (unit, global) at other local maxima of
+  // the dual that the global search reached, best first. A warm start
+  // follows them with one Newton step each to notice when one overtakes the
+  // answer; rival_count -1: no global search behind this result.
+  int rival_count = -1;
+  Eigen::Vector3d rivals[2] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX()};
   ContactSummary summary;
 };
 
 /// The minimum signed distance between A and B. `warm_start` (the previous
 /// time step's result, section 5.4.5) seeds Newton; nullptr means cold.
+/// Two ellipsoids go to ellipsoidContact unless options.solver is CommonNormal.
 ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const ContactOptions& options = {},
                              const ContactResult* warm_start = nullptr);
 
