@@ -99,6 +99,8 @@ class RunCommand : public cli::Command {
     if (first > last) throw UsageError("--from " + from_ + " comes after --until " + until_);
     if (!fs::exists(input_)) throw InputError("input '" + input_.string() + "' does not exist: expected a DICOM folder or a CT image file");
     fs::create_directories(output_ / ".articula");
+    if (const int stale = removeStaleTemporaries(output_))
+      log::info("removed " + std::to_string(stale) + " unfinished file(s) of an interrupted earlier run");
     for (int i = first; i <= last; ++i) {
       const std::string& stage = kStages[i];
       const auto plan = stagePlan(stage, common);

@@ -34,7 +34,7 @@ assert abs(s["curvature_min_per_mm"] - 18 / 30**2) < 1e-9, s["curvature_min_per_
 assert s["provenance"]["coordinate_system"] == "LPS"
 PY
 head -3 "$tmp/e.ply" | grep -q "LPS" || fail "PLY says LPS"
-ls "$tmp" | grep -q "tmp-" && fail "temporary file left behind"
+ls -A "$tmp" | grep -q "tmp-" && fail "temporary file left behind"
 
 # Existing output without --force: exit 2 and the file is untouched.
 before=$(sha256sum "$tmp/e.ply")

@@ -1,5 +1,9 @@
 #include "articula/core/atomic_file.hpp"
 
+#include <cerrno>
+#include <csignal>
+#include <vector>
+
 #include <unistd.h>
 
 #include "articula/core/error.hpp"
@@ -11,8 +15,7 @@ AtomicFile::AtomicFile(std::filesystem::path path, bool overwrite, bool binary) 
     throw UsageError("output '" + path_.string() + "' exists: pass --force to overwrite it");
   if (path_.has_parent_path() && !std::filesystem::exists(path_.parent_path()))
     std::filesystem::create_directories(path_.parent_path());
-  temp_ = path_;
-  temp_ += ".tmp-" + std::to_string(::getpid());
+  temp_ = temporaryPathFor(path_);
   out_.open(temp_, binary ? std::ios::out | std::ios::binary : std::ios::out);
   if (!out_) throw InputError("cannot open '" + temp_.string() + "' for writing");
 }
@@ -33,6 +36,31 @@ void AtomicFile::commit() {
   std::filesystem::rename(temp_, path_, ec);
   if (ec) throw InputError("cannot rename '" + temp_.string() + "' to '" + path_.string() + "': " + ec.message());
   committed_ = true;
+}
+
+std::filesystem::path temporaryPathFor(const std::filesystem::path& path) {
+  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  return folder / (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string());
+}
+
+int removeStaleTemporaries(const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) return 0;
+  std::vector<fs::path> stale;
+  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(".tmp-", 0) != 0) continue;
+    const std::string digits = name.substr(5, name.find('-', 5) - 5);
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stoll(digits));
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // its writer still runs (or is not ours to ask)
+    stale.push_back(it->path());
+  }
+  int removed = 0;
+  for (const fs::path& p : stale) removed += fs::remove(p, ec) ? 1 : 0;
+  return removed;
 }
 
 void writeFileAtomically(const std::filesystem::path& path, const std::string& text, bool overwrite) {

@@ -10,6 +10,7 @@
 #include <itkImageFileReader.h>
 #include <itkImageFileWriter.h>
 
+#include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/imaging/image.hpp"
 
@@ -87,7 +88,7 @@ void writeImageFile(const std::filesystem::path& path, const Image<T>& image, bo
   const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(folder, ec);
-  const fs::path temp = folder / (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string());
+  const fs::path temp = temporaryPathFor(path);
   auto writer = itk::ImageFileWriter<itk::Image<T, 3>>::New();
   writer->SetInput(toItk(image));
   writer->SetFileName(temp.string());

@@ -29,6 +29,7 @@
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 
 namespace articula::mesh {
@@ -211,7 +212,7 @@ void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
   const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(folder, ec);
-  const fs::path temp = folder / (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string());
+  const fs::path temp = temporaryPathFor(path);
   const vtkSmartPointer<vtkPolyData> poly = toVtk(mesh);
   int ok = 0;
   if (ext == ".vtp") {

@@ -10,7 +10,7 @@ namespace articula {
 
 class AtomicFile {
  public:
-  /// Opens `<path>.tmp-<pid>` for writing; throws InputError if it cannot.
+  /// Opens temporaryPathFor(path) for writing; throws InputError if it cannot.
   /// Refuses to replace an existing `path` unless `overwrite` is true (UsageError).
   explicit AtomicFile(std::filesystem::path path, bool overwrite = true, bool binary = false);
   ~AtomicFile();
@@ -26,6 +26,16 @@ class AtomicFile {
   std::ofstream out_;
   bool committed_ = false;
 };
+
+/// The name a file is written under until it is complete:
+/// `<folder>/.tmp-<pid>-<name>` (hidden, and keeping the extension, from
+/// which ITK and VTK writers choose the format).
+std::filesystem::path temporaryPathFor(const std::filesystem::path& path);
+
+/// Removes the temporaries (temporaryPathFor) under `folder`, recursively,
+/// whose writing process no longer runs: a killed run leaves them behind.
+/// Returns how many were removed.
+int removeStaleTemporaries(const std::filesystem::path& folder);
 
 /// Writes `text` to `path` atomically.
 void writeFileAtomically(const std::filesystem::path& path, const std::string& text, bool overwrite = true);

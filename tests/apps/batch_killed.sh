@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# A batch killed in the middle of a subject (SIGKILL to its whole process
+# group, as a cluster's preemption or a closed terminal does) resumes: the
+# finished subject is not redone, the interrupted one is redone from
+# scratch, no temporary file is left behind, and the study tables equal
+# those of an uninterrupted batch.
+source "$(dirname "$0")/common.bash"
+
+models=(sphere ellipsoid superellipsoid)
+echo "subject,input,joint,side" > "$tmp/study.csv"
+for i in 1 2 3; do
+  "$bin/articula" phantom -o "$tmp/data/s$i" --seed $((20 + i)) --model "${models[$((i - 1))]}" --no-dicom --quiet
+  echo "s$i,data/s$i/phantom.nii.gz,hip,right" >> "$tmp/study.csv"
+done
+"$bin/articula" batch "$tmp/study.csv" -o "$tmp/reference" -j 1 --quiet
+
+setsid "$bin/articula" batch "$tmp/study.csv" -o "$tmp/killed" -j 1 --quiet 2> "$tmp/killed.err" &
+pid=$!
+for _ in $(seq 1 1200); do
+  [ -e "$tmp/killed/subjects/s1/status.json" ] && break
+  sleep 0.25
+done
+[ -e "$tmp/killed/subjects/s1/status.json" ] || fail "subject s1 did not finish within 5 minutes"
+sleep 1  # s2 is now under way
+kill -KILL -- "-$pid"
+wait "$pid" || true
+[ ! -e "$tmp/killed/subjects/s2/status.json" ] || fail "s2 finished before the kill: nothing was interrupted"
+[ ! -e "$tmp/killed/study.csv" ] || fail "a killed batch left study.csv looking complete"
+cp "$tmp/killed/subjects/s1/status.json" "$tmp/s1-status.json"
+cp "$tmp/killed/subjects/s1/results.json" "$tmp/s1-results.json"
+
+"$bin/articula" batch "$tmp/study.csv" -o "$tmp/killed" -j 1 2> "$tmp/resume.err" ||
+  { cat "$tmp/resume.err" >&2; fail "the resumed batch failed"; }
+grep -q "3 ok (1 from an earlier run)" "$tmp/resume.err" || { cat "$tmp/resume.err" >&2; fail "s1 was redone"; }
+cmp "$tmp/s1-status.json" "$tmp/killed/subjects/s1/status.json" || fail "s1's status changed"
+cmp "$tmp/s1-results.json" "$tmp/killed/subjects/s1/results.json" || fail "s1's results changed"
+leftovers=$(find "$tmp/killed" -name '.tmp-*')
+[ -z "$leftovers" ] || fail "temporary files left behind: $leftovers"
+diff "$tmp/reference/study.csv" "$tmp/killed/study.csv" || fail "study.csv differs from an uninterrupted batch"
+diff "$tmp/reference/study_summary.csv" "$tmp/killed/study_summary.csv" || fail "study_summary.csv differs"
+echo "killed batch resumed: ok"
