@@ -35,6 +35,8 @@ class SegmentCommand : public cli::Command {
     app.add_option("--hu-min", options_.hu_min, "Lower end of the bone window (HU)")->capture_default_str();
     app.add_option("--hu-max", options_.hu_max, "Upper end of the bone window (HU)")->capture_default_str();
     app.add_option("--surface-hu", options_.surface_hu, "Level of the head's final surface (HU)")->capture_default_str();
+    app.add_option("--level-set", options_.level_set_iterations,
+                   "Refine the head's surface by a geodesic active contour of this many iterations (0: off)")->capture_default_str();
     app.add_option("--close-radius", options_.close_radius_mm,
                    "Closing radius before hole filling, mm (bridges speckled cancellous bone; 0: off)")->capture_default_str();
     app.add_option("--midline-margin", options_.midline_margin_mm,
@@ -75,7 +77,8 @@ class SegmentCommand : public cli::Command {
                              {"min_radius_mm", options_.min_head_radius_mm},
                              {"max_radius_mm", options_.max_head_radius_mm},
                              {"close_radius_mm", options_.close_radius_mm}, {"min_coverage", options_.min_coverage},
-                             {"midline_margin_mm", options_.midline_margin_mm}};
+                             {"midline_margin_mm", options_.midline_margin_mm},
+                             {"level_set_iterations", options_.level_set_iterations}};
     if (options_.seed_point) params["seed_point_mm"] = vec(*options_.seed_point);
     if (options_.roi_min) params["roi_mm"] = {vec(*options_.roi_min), vec(*options_.roi_max)};
     std::vector<std::filesystem::path> inputs;

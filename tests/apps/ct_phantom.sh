@@ -7,8 +7,10 @@ T=$ARTICULA_TMP
 rm -rf "$T" && mkdir -p "$T"
 
 "$B/articula" phantom -o "$T/p" --seed 5 --model sphere --gap 3 -q
-for input in "$T/p/phantom.nii.gz" "$T/p/dicom"; do
-  "$B/articula-segment" -i "$input" -o "$T/head.nii.gz" --joint hip --side right --force -q
+# NIfTI and DICOM input; and the surface by the level set (active contour).
+for run in "$T/p/phantom.nii.gz" "$T/p/dicom" "$T/p/phantom.nii.gz --level-set 100"; do
+  read -r input extra <<< "$run"
+  "$B/articula-segment" -i "$input" -o "$T/head.nii.gz" --joint hip --side right --force -q $extra
   "$B/articula-mesh" -i "$T/head.nii.gz" -o "$T/head.vtp" --force -q
   "$B/articula-sample" -i "$T/head.vtp" -o "$T/points.ply" --ball-radius 1.0 --seed 1 --force -q --json > "$T/sample.json"
   test -s "$T/points.ply"

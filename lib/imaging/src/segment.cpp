@@ -10,7 +10,10 @@
 #include <itkBlackTopHatImageFilter.h>
 #include <itkSmoothingRecursiveGaussianImageFilter.h>
 #include <itkFlatStructuringElement.h>
+#include <itkGeodesicActiveContourLevelSetImageFilter.h>
+#include <itkGradientMagnitudeRecursiveGaussianImageFilter.h>
 #include <itkMorphologicalWatershedFromMarkersImageFilter.h>
+#include <itkSigmoidImageFilter.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
 
 #include "articula/core/error.hpp"
@@ -294,6 +297,66 @@ Mask watershedHead(const Image<float>& distance, const Mask& bone, const Eigen::
   return fillHoles(close(head, r / 3));
 }
 
+/// Median of the values of `image` where `where` holds.
+double medianWhere(const Image<float>& image, const std::vector<char>& where) {
+  std::vector<float> v;
+  for (size_t n = 0; n < where.size(); ++n)
+    if (where[n]) v.push_back(image.voxels[n]);
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+/// Geodesic active contour (Caselles et al. 1997; the "snake" of ITK-SNAP
+/// the thesis used), started from the head label: it pulls the surface onto
+/// the strongest HU edge nearby and smooths it. The edge map is a sigmoid of
+/// the gradient magnitude scaled by the label's own statistics (the median
+/// gradient on its boundary is an edge, the median inside is not). The result
+/// stays within two voxels of the label, so it cannot leak across the gap.
+Mask refineByLevelSet(const Volume& hu, const Mask& head, int iterations) {
+  using FloatImage = itk::Image<float, 3>;
+  const ImageGeometry& g = hu.geometry;
+  auto gradient = itk::GradientMagnitudeRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
+  gradient->SetInput(toItk(hu));
+  gradient->SetSigma(g.spacing.minCoeff());
+  gradient->Update();
+  const Image<float> magnitude = fromItk<float>(gradient->GetOutput());
+  const Image<float> initial = signedDistance(head);  // mm, negative inside
+  const double voxel = g.spacing.maxCoeff();
+  std::vector<char> boundary(head.voxels.size()), interior(head.voxels.size());
+  for (size_t n = 0; n < head.voxels.size(); ++n) {
+    boundary[n] = std::abs(initial.voxels[n]) <= voxel;
+    interior[n] = initial.voxels[n] < -3 * voxel;
+  }
+  const double edge = medianWhere(magnitude, boundary), flat = medianWhere(magnitude, interior);
+  if (!(edge > flat)) return head;  // no edge to snap to
+  auto sigmoid = itk::SigmoidImageFilter<FloatImage, FloatImage>::New();
+  sigmoid->SetInput(gradient->GetOutput());
+  sigmoid->SetOutputMinimum(0.0f);
+  sigmoid->SetOutputMaximum(1.0f);
+  sigmoid->SetAlpha(-(edge - flat) / 6.0);  // the ITK guide's choice: ~0 on edges, ~1 inside
+  sigmoid->SetBeta((edge + flat) / 2.0);
+  auto contour = itk::GeodesicActiveContourLevelSetImageFilter<FloatImage, FloatImage>::New();
+  contour->SetInput(toItk(initial));
+  contour->SetFeatureImage(sigmoid->GetOutput());
+  contour->SetPropagationScaling(0.0);
+  contour->SetCurvatureScaling(0.5);
+  contour->SetAdvectionScaling(1.0);
+  contour->SetMaximumRMSError(0.002);
+  contour->SetNumberOfIterations(static_cast<itk::IdentifierType>(iterations));
+  contour->Update();
+  const Image<float> phi = fromItk<float>(contour->GetOutput());
+  Mask out = head;
+  for (size_t n = 0; n < out.voxels.size(); ++n) {
+    const float d = initial.voxels[n];
+    out.voxels[n] = d < -2 * voxel || (d <= 2 * voxel && phi.voxels[n] < 0) ? 1 : 0;
+  }
+  log::debug("level set: " + std::to_string(contour->GetElapsedIterations()) + " iterations, RMS change " +
+             std::to_string(contour->GetRMSChange()) + ", edge " + std::to_string(edge) + " HU/mm, flat " +
+             std::to_string(flat) + " HU/mm");
+  return fillHoles(out);
+}
+
 }  // namespace
 
 void SegmentOptions::validate() const {
@@ -305,6 +368,7 @@ void SegmentOptions::validate() const {
     throw UsageError("head radius range must satisfy 0 < min < max");
   if (!(search_spacing_mm > 0)) throw UsageError("search spacing must be > 0");
   if (!(close_radius_mm >= 0)) throw UsageError("--close-radius must be >= 0");
+  if (level_set_iterations < 0) throw UsageError("--level-set must be >= 0 iterations");
   if (!(midline_margin_mm >= 0)) throw UsageError("--midline-margin must be >= 0");
   if (!(min_coverage >= 0 && min_coverage <= 1)) throw UsageError("--min-coverage must lie in [0, 1]");
 }
@@ -446,9 +510,12 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     summary.warnings.push_back("the labelled head is thin (depth " + std::to_string(best) +
                                " mm): the seed may not be in a joint head");
 
-  // The surface at the surface level (nearer half maximum than the window's
-  // lower end, which sits a third of a voxel outside in partial volume).
-  if (options.surface_hu > options.hu_min) {
+  // The surface: on the HU edge by an active contour, or at the surface
+  // level (nearer half maximum than the window's lower end, which sits a
+  // third of a voxel outside in partial volume).
+  if (options.level_set_iterations > 0) {
+    head = refineByLevelSet(box_hu, head, options.level_set_iterations);
+  } else if (options.surface_hu > options.hu_min) {
     // Peel twice: only voxels on the label's outer layer, so the cortex keeps
     // the darker cancellous interior inside.
     for (int peel = 0; peel < 2; ++peel) {

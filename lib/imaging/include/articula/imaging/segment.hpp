@@ -33,6 +33,7 @@ struct SegmentOptions {
   double gap_width_mm = 4.0;     // widest joint gap the valley filter closes
   double gap_contrast_hu = 300;  // black top-hat above which a voxel is gap, not bone (0: off)
   double surface_hu = 400;       // level of the head's final surface (<= hu_min: the window's end)
+  int level_set_iterations = 0;  // > 0: the surface by a geodesic active contour instead of surface_hu
   /// Throws UsageError naming the first invalid option.
   void validate() const;
 };
