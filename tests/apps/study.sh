@@ -59,6 +59,16 @@ for s in ("p1", "p2"):
 summary = {r["model"]: r for r in csv.DictReader(open(f"{study}/study_summary.csv"))}
 assert set(summary) == models and summary["sphere"]["n_subjects"] == "2"
 assert summary["ellipsoid"]["wilcoxon_p_vs_sphere"] != ""
+# study.svg: one line per good subject, one dot per subject x model, the means of study_summary.csv.
+import re
+svg = open(f"{study}/study.svg").read()
+assert svg.count('<g class="subject">') == 2, svg.count('<g class="subject">')
+assert svg.count("</circle>") == len(rows), (svg.count("</circle>"), len(rows))
+means = {m: (float(v), int(n)) for m, v, n in re.findall(r"<title>mean (\w+): ([-0-9.e]+) mm \((\d+) subjects\)", svg)}
+assert set(means) == models, means
+for m, (v, n) in means.items():
+    assert abs(v - float(summary[m]["rms_mean_mm"])) <= 0.005 * float(summary[m]["rms_mean_mm"]), (m, v, summary[m])
+    assert n == 2
 PY
 
 # A rerun resumes: nothing is redone, and it is fast.
