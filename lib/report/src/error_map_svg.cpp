@@ -67,7 +67,7 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
   const double limit = options.limit_mm > 0.0 ? options.limit_mm : automaticLimit(panels);
   double extent = n ? map.xy.cwiseAbs().maxCoeff() : 0.0;
   if (!(extent > 0.0)) extent = 1.0;
-  const double tick = svg::tickStep(extent, 2);
+  const double tick = svg::tickStep(extent, 3);
   extent = std::ceil(extent / tick - 1e-9) * tick;
   const Eigen::Index stride = (n + options.max_points - 1) / options.max_points;
 

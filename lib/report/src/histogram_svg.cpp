@@ -99,8 +99,8 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
       out << "\"/>\n";
     }
     const double ly = top + 10 + 18.0 * static_cast<double>(k);
-    out << "<line x1=\"" << left + pw - 230 << "\" y1=\"" << ly << "\" x2=\"" << left + pw - 205 << "\" y2=\"" << ly
-        << "\" stroke-width=\"2\" stroke=\"" << svg::seriesColour(k) << "\"/><text x=\"" << left + pw - 200 << "\" y=\"" << ly + 4
+    out << "<line x1=\"" << left + pw - 320 << "\" y1=\"" << ly << "\" x2=\"" << left + pw - 295 << "\" y2=\"" << ly
+        << "\" stroke-width=\"2\" stroke=\"" << svg::seriesColour(k) << "\"/><text x=\"" << left + pw - 290 << "\" y=\"" << ly + 4
         << "\">" << svg::escape(s.label) << std::setprecision(3) << " (mu " << s.mu << ", sigma " << s.sigma << " mm)"
         << std::setprecision(2) << "</text>\n";
   }
