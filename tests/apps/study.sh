@@ -89,6 +89,8 @@ if command -v snakemake > /dev/null; then
     { tail -30 "$tmp/snake.log" >&2; fail "snakemake failed"; }
   diff "$tmp/batch-good/study.csv" "$tmp/snake/study.csv" || fail "snakemake study.csv differs from batch"
   diff "$tmp/batch-good/study_summary.csv" "$tmp/snake/study_summary.csv" || fail "study_summary.csv differs"
+  [ "$(grep -c '<g class="subject">' "$tmp/snake/study.svg")" -eq 2 ] || fail "snakemake study.svg"
+  [ -s "$tmp/snake/subjects/p1/errors/error_map.svg" ] || fail "snakemake error_map.svg"
   # Same seed, same outputs (batch-good vs the first batch, subject p2).
   cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-good/subjects/p2/points.ply" || fail "same seed, different points"
   cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-good/subjects/p2/results.csv" || fail "same seed, different fits"
