@@ -1,7 +1,8 @@
 // `articula errors` / articula-errors: signed Euclidean distances from the
 // points to every fitted model (fits.json), with thesis tables 3.3-3.4
 // (summary.csv/.json), per-point errors.csv, the histograms of fig. 3.5
-// (histogram.svg), points coloured as fig. 3.4 and each fitted surface (PLY).
+// (histogram.svg), points coloured as fig. 3.4 (PLY, and flat maps in
+// error_map.svg) and each fitted surface (PLY).
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -18,6 +19,7 @@
 #include "articula/fit/fits_json.hpp"
 #include "articula/geometry/surface.hpp"
 #include "articula/points/point_io.hpp"
+#include "articula/report/error_map_svg.hpp"
 #include "articula/report/error_statistics.hpp"
 #include "articula/report/histogram_svg.hpp"
 #include "articula/report/ply_writers.hpp"
@@ -68,7 +70,8 @@ class ErrorsCommand : public cli::Command {
  public:
   std::string name() const override { return "errors"; }
   std::string description() const override {
-    return "Signed Euclidean distances to the fitted models: tables 3.3-3.4, errors.csv, histogram.svg, coloured PLY";
+    return "Signed Euclidean distances to the fitted models: tables 3.3-3.4, errors.csv, histogram.svg, error_map.svg, "
+           "coloured PLY";
   }
   std::string example() const override { return "articula-errors -i head.ply --fits fits.json -o errors/"; }
   void declare(CLI::App& app) override {
@@ -80,6 +83,9 @@ class ErrorsCommand : public cli::Command {
         ->capture_default_str();
     app.add_option("--resolution", resolution_, "Surface mesh steps around the local z axis")
         ->check(CLI::Range(8, 2048))
+        ->capture_default_str();
+    app.add_option("--map-points", map_points_, "Points drawn per model in error_map.svg (every k-th when more)")
+        ->check(CLI::PositiveNumber)
         ->capture_default_str();
   }
 
@@ -102,7 +108,8 @@ class ErrorsCommand : public cli::Command {
     std::error_code ec;
     std::filesystem::create_directories(output_, ec);
     if (ec) throw InputError("--output: cannot create the folder '" + output_.string() + "': " + ec.message());
-    const std::vector<std::string> outputs = {"summary.csv", "summary.json", "errors.csv", "histogram.svg"};
+    const std::vector<std::string> outputs = {"summary.csv", "summary.json", "errors.csv", "histogram.svg",
+                                             "error_map.svg"};
     for (const auto& f : outputs)
       if (std::filesystem::exists(output_ / f) && !common.force)
         throw UsageError("output '" + (output_ / f).string() + "' exists (use --force to overwrite)");
@@ -155,6 +162,21 @@ class ErrorsCommand : public cli::Command {
     writeFileAtomically(output_ / "histogram.svg",
                         report::histogramSvg(series, "Signed Euclidean distances: " + input_.filename().string()),
                         common.force);
+    // Maps about the best model's centre (fits.json's best_model, else the least RMS here).
+    size_t best = 0;
+    for (size_t m = 0; m < shapes.size(); ++m)
+      if (doc.contains("best_model") ? geometry::modelName(shapes[m].model) == doc["best_model"]
+                                     : rows[m].rms_mm < rows[best].rms_mm)
+        best = m;
+    std::vector<report::ErrorMapPanel> panels;
+    for (size_t m = 0; m < shapes.size(); ++m) panels.push_back({rows[m].model, all.col(static_cast<Eigen::Index>(m))});
+    report::ErrorMapOptions map_options;
+    map_options.max_points = map_points_;
+    map_options.highlight = rows[best].model;
+    writeFileAtomically(output_ / "error_map.svg",
+                        report::errorMapSvg(report::azimuthalEqualArea(P, shapes[best].center), panels, map_options,
+                                            "Signed distances to the fitted surfaces: " + input_.filename().string()),
+                        common.force);
     if (common.json) cli::printJson({{"output", output_.string()}, {"models", report::summaryJson(rows)}});
     return 0;
   }
@@ -163,6 +185,7 @@ class ErrorsCommand : public cli::Command {
   std::filesystem::path input_, fits_, output_;
   double band_mm_ = 0.1;
   int resolution_ = 96;
+  int map_points_ = 2000;
 };
 
 ARTICULA_REGISTER_COMMAND(ErrorsCommand)

@@ -165,7 +165,7 @@ class RunCommand : public cli::Command {
       p = {{"-i", points.string(), "-o", fits.string()}, {points}, {fits, output_ / "fits.csv"}};
     } else if (stage == "errors") {
       p = {{"-i", points.string(), "--fits", fits.string(), "-o", errors.string()}, {points, fits},
-           {errors / "summary.json"}};
+           {errors / "summary.json", errors / "histogram.svg", errors / "error_map.svg"}};
     } else {
       p = {{}, {fits, errors / "summary.json"}, {output_ / "results.json", output_ / "results.csv", output_ / "head.mrk.json"}};
       return p;

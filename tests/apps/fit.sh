@@ -34,9 +34,9 @@ expect_rc 0 "$bin/articula-fit" -i "$tmp/so.ply" -o "$tmp/g2.json" --seed 3 --st
 # (all columns but the timing)
 diff <(cut -d, -f1-25 "$tmp/g1.csv") <(cut -d, -f1-25 "$tmp/g2.csv") >/dev/null || fail "same seed, same fit"
 
-# errors: tables, per-point errors, histogram, coloured points and surfaces.
+# errors: tables, per-point errors, histogram, error maps, coloured points and surfaces.
 expect_rc 0 "$bin/articula-errors" -i "$tmp/so.ply" --fits "$tmp/fits.json" -o "$tmp/report"
-for f in summary.csv summary.json errors.csv histogram.svg points_sphere.ply points_superovoid.ply \
+for f in summary.csv summary.json errors.csv histogram.svg error_map.svg points_sphere.ply points_superovoid.ply \
          surface_superovoid.ply surface_ovoid.ply; do
   [ -s "$tmp/report/$f" ] || fail "errors wrote $f"
 done
@@ -47,6 +47,27 @@ e_rms=$(csv_value "$tmp/report/summary.csv" ellipsoid rms_mm)
 f_rms=$(csv_value "$tmp/fits.csv" ellipsoid rms_mm)
 awk -v a="$e_rms" -v b="$f_rms" 'BEGIN{d=a-b; if(d<0)d=-d; exit !(d < 1e-6)}' || fail "errors rms $e_rms vs fit $f_rms"
 grep -q "signed Euclidean distance (mm)" "$tmp/report/histogram.svg" || fail "histogram axis label"
+# error_map.svg: one panel per model, one dot per point (all of them: fewer than
+# --map-points), the dots' colours follow d, the best model is marked.
+python3 - "$tmp/report" "$tmp/fits.json" <<'PY'
+import csv, json, re, sys
+folder = sys.argv[1]
+svg = open(f"{folder}/error_map.svg").read()
+rows = list(csv.DictReader(open(f"{folder}/errors.csv")))
+models = [c[2:-3] for c in rows[0] if c.startswith("d_")]
+assert len(rows) <= 2000, len(rows)
+assert svg.count('<g class="panel">') == len(models), models
+dots = {}  # colour -> dots over all panels
+for m in re.finditer(r'<path class="pts" stroke="(#[0-9a-f]{6})" d="([^"]*)"', svg):
+    dots[m.group(1)] = dots.get(m.group(1), 0) + m.group(2).count("h0")
+assert sum(dots.values()) == len(rows) * len(models), (sum(dots.values()), len(rows), models)
+limit = float(re.search(r'data-limit-mm="([^"]+)"', svg).group(1))
+# Points at or beyond -limit (rounded to the nearest step) take the darkest red.
+deep = sum(1 for r in rows for m in models if float(r[f"d_{m}_mm"]) <= -limit * 0.95)
+assert dots.get("#b2182b", 0) == deep, (dots.get("#b2182b"), deep, limit)
+best = json.load(open(sys.argv[2]))["best_model"]
+assert f"{best}: RMS" in svg and "(best)" in svg, best
+PY
 [ "$(wc -l < "$tmp/report/errors.csv")" -eq "$(( $(grep -m1 'element vertex' "$tmp/so.ply" | awk '{print $3}') + 1 ))" ] \
   || fail "errors.csv has one row per point"
 

@@ -59,6 +59,16 @@ for s in ("p1", "p2"):
 summary = {r["model"]: r for r in csv.DictReader(open(f"{study}/study_summary.csv"))}
 assert set(summary) == models and summary["sphere"]["n_subjects"] == "2"
 assert summary["ellipsoid"]["wilcoxon_p_vs_sphere"] != ""
+# study.svg: one line per good subject, one dot per subject x model, the means of study_summary.csv.
+import re
+svg = open(f"{study}/study.svg").read()
+assert svg.count('<g class="subject">') == 2, svg.count('<g class="subject">')
+assert svg.count("</circle>") == len(rows), (svg.count("</circle>"), len(rows))
+means = {m: (float(v), int(n)) for m, v, n in re.findall(r"<title>mean (\w+): ([-0-9.e]+) mm \((\d+) subjects\)", svg)}
+assert set(means) == models, means
+for m, (v, n) in means.items():
+    assert abs(v - float(summary[m]["rms_mean_mm"])) <= 0.005 * float(summary[m]["rms_mean_mm"]), (m, v, summary[m])
+    assert n == 2
 PY
 
 # A rerun resumes: nothing is redone, and it is fast.
@@ -79,6 +89,8 @@ if command -v snakemake > /dev/null; then
     { tail -30 "$tmp/snake.log" >&2; fail "snakemake failed"; }
   diff "$tmp/batch-good/study.csv" "$tmp/snake/study.csv" || fail "snakemake study.csv differs from batch"
   diff "$tmp/batch-good/study_summary.csv" "$tmp/snake/study_summary.csv" || fail "study_summary.csv differs"
+  [ "$(grep -c '<g class="subject">' "$tmp/snake/study.svg")" -eq 2 ] || fail "snakemake study.svg"
+  [ -s "$tmp/snake/subjects/p1/errors/error_map.svg" ] || fail "snakemake error_map.svg"
   # Same seed, same outputs (batch-good vs the first batch, subject p2).
   cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-good/subjects/p2/points.ply" || fail "same seed, different points"
   cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-good/subjects/p2/results.csv" || fail "same seed, different fits"

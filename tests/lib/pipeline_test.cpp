@@ -2,6 +2,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -176,4 +177,39 @@ TEST(Markups, SlicerSchemaInLps) {
   EXPECT_EQ(fiducial.at("controlPoints").at(0).at("position"), nlohmann::json({1.5, -2.0, 3.0}));
   EXPECT_EQ(doc.at("markups").at(1).at("type"), "Line");
   EXPECT_EQ(doc.at("markups").at(1).at("controlPoints").size(), 2u);
+}
+
+TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
+  const fs::path dir = scratch("study");
+  const std::vector<std::string> ids = {"s2", "s1", "bad"};  // manifest order, not sorted
+  const double rms[2][2] = {{0.5, 0.2}, {0.3, 0.1}};
+  std::vector<p::Subject> subjects;
+  p::BatchSummary batch;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    subjects.push_back({ids[i], dir / ids[i], "hip", "right", {}, static_cast<int>(i) + 2});
+    batch.outcomes.push_back({ids[i], i < 2 ? "ok" : "failed", i < 2 ? 0 : 3, "", 1.0, false});
+    if (i == 2) continue;
+    nlohmann::json models = nlohmann::json::array();
+    for (int m = 0; m < 2; ++m)
+      models.push_back({{"model", m ? "ellipsoid" : "sphere"},
+                        {"n_parameters", m ? 9 : 4},
+                        {"parameters", {{"a_mm", 20.0}}},
+                        {"errors", {{"n_points", 100}, {"rms_mm", rms[i][m]}}},
+                        {"aic", -100.0 * (m + 1)},
+                        {"bic", -90.0 * (m + 1)}});
+    fs::create_directories(p::subjectDir(dir, ids[i]));
+    write(p::subjectDir(dir, ids[i]) / "results.json",
+          nlohmann::json({{"best_model", "ellipsoid"}, {"models", models}}).dump());
+  }
+  p::writeStudyTables(dir, subjects, batch, nlohmann::json::object());
+  std::ifstream in(dir / "study.svg");
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto has = [&](const std::string& s) { return svg.find(s) != std::string::npos; };
+  EXPECT_TRUE(has("<title>s2 sphere: 0.5 mm</title>"));
+  EXPECT_TRUE(has("<title>s1 ellipsoid: 0.1 mm</title>"));
+  EXPECT_TRUE(has("<title>mean sphere: 0.4 mm (2 subjects)</title>"));
+  EXPECT_TRUE(has("<title>mean ellipsoid: 0.15 mm (2 subjects)</title>"));
+  EXPECT_TRUE(has("across 2 subjects"));
+  EXPECT_FALSE(has("bad"));
+  EXPECT_LT(svg.find("<title>s2 sphere"), svg.find("<title>s1 sphere"));  // manifest order
 }

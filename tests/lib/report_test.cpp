@@ -1,14 +1,21 @@
 // Error statistics against hand-computed values and a large normal sample;
-// histogram counts; the SVG and PLY outputs' content.
+// histogram counts; the equal-area map against its closed form; the SVG and
+// PLY outputs' content.
 #include <cmath>
 #include <random>
+#include <map>
+#include <regex>
 
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
+#include "articula/report/azimuthal_map.hpp"
+#include "articula/report/diverging_colour.hpp"
+#include "articula/report/error_map_svg.hpp"
 #include "articula/report/error_statistics.hpp"
 #include "articula/report/histogram_svg.hpp"
 #include "articula/report/ply_writers.hpp"
+#include "articula/report/study_svg.hpp"
 
 namespace {
 
@@ -63,6 +70,146 @@ TEST(HistogramSvg, HasAxesUnitsLegendAndCurves) {
   size_t curves = 0;
   for (size_t p = svg.find("<polyline"); p != std::string::npos; p = svg.find("<polyline", p + 1)) ++curves;
   EXPECT_EQ(curves, 2u);
+}
+
+size_t count(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+// Dots per colour over the whole document: stroke colour -> number of "M x y h0".
+std::map<std::string, size_t> dotsByColour(const std::string& svg) {
+  std::map<std::string, size_t> dots;
+  const std::regex path("<path class=\"pts\" stroke=\"(#[0-9a-f]{6})\" d=\"([^\"]*)\"");
+  for (std::sregex_iterator it(svg.begin(), svg.end(), path), end; it != end; ++it)
+    dots[(*it)[1]] += count((*it)[2], "h0");
+  return dots;
+}
+
+// A cap of a sphere (radius 20 about c) around +L: the apex and rings at 60
+// and 90 degrees, symmetric so that the mean direction is +L.
+Eigen::MatrixX3d capAboutLeft(const Eigen::Vector3d& c) {
+  Eigen::MatrixX3d p(17, 3);
+  p.row(0) = (c + Eigen::Vector3d(20, 0, 0)).transpose();
+  for (int k = 0; k < 8; ++k) {
+    const double phi = k * M_PI / 4;
+    for (int ring = 0; ring < 2; ++ring) {
+      const double theta = ring ? M_PI / 2 : M_PI / 3;
+      const Eigen::Vector3d u(std::cos(theta), std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi));
+      p.row(1 + 2 * k + ring) = (c + 20 * u).transpose();
+    }
+  }
+  return p;
+}
+
+TEST(AzimuthalMap, EqualAreaRadiiAndOrientation) {
+  const Eigen::Vector3d c(-80, 12, 30);
+  const AzimuthalMap map = azimuthalEqualArea(capAboutLeft(c), c);
+  EXPECT_NEAR((map.axis - Eigen::Vector3d::UnitX()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((map.up - Eigen::Vector3d::UnitZ()).norm(), 0.0, 1e-12);     // S up
+  EXPECT_NEAR((map.right - Eigen::Vector3d::UnitY()).norm(), 0.0, 1e-12);  // P right, seen from the left
+  EXPECT_NEAR(map.radius_mm, 20.0, 1e-12);
+  EXPECT_NEAR(map.xy.row(0).norm(), 0.0, 1e-12);
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector2d at60 = map.xy.row(1 + 2 * k), at90 = map.xy.row(2 + 2 * k);
+    EXPECT_NEAR(at60.norm(), 2 * 20 * std::sin(M_PI / 6), 1e-9);  // 2 R sin(theta/2)
+    EXPECT_NEAR(at90.norm(), 20 * std::sqrt(2.0), 1e-9);
+    EXPECT_NEAR(std::atan2(at90.y(), at90.x()), std::remainder(k * M_PI / 4, 2 * M_PI), 1e-9);
+  }
+  // Points all round the centre: no main direction; the axis is S and up is P.
+  Eigen::MatrixX3d round(6, 3);
+  round << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  const AzimuthalMap all = azimuthalEqualArea(round, Eigen::Vector3d::Zero());
+  EXPECT_EQ(all.axis, Eigen::Vector3d::UnitZ());
+  EXPECT_NEAR((all.up - Eigen::Vector3d::UnitY()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(all.xy.row(5).norm(), 2.0, 1e-12);  // opposite the axis: 2R
+}
+
+TEST(DivergingColour, StopsMidpointsAndClamping) {
+  EXPECT_EQ(divergingColour(-1.0), "#b2182b");
+  EXPECT_EQ(divergingColour(-5.0), "#b2182b");
+  EXPECT_EQ(divergingColour(0.0), "#dddddd");
+  EXPECT_EQ(divergingColour(0.5), "#67a9cf");
+  EXPECT_EQ(divergingColour(1.0), "#2166ac");
+  EXPECT_EQ(divergingColour(0.25), "#a2c3d6");  // halfway between #dddddd and #67a9cf
+}
+
+TEST(ErrorMapSvg, OneDotPerPointColouredByDistance) {
+  const Eigen::Vector3d c(10, -20, 5);
+  const AzimuthalMap map = azimuthalEqualArea(capAboutLeft(c), c);
+  Eigen::VectorXd inside_out(17), small(17);
+  for (int i = 0; i < 17; ++i) {
+    inside_out[i] = i < 5 ? -0.5 : i < 11 ? 0.0 : 0.7;  // 0.7 is beyond the limit: the end colour
+    small[i] = 0.05;
+  }
+  ErrorMapOptions options;
+  options.limit_mm = 0.5;
+  options.highlight = "superovoid";
+  const std::string svg = errorMapSvg(map, {{"sphere", inside_out}, {"superovoid", small}}, options, "head & neck");
+  EXPECT_EQ(count(svg, "<g class=\"panel\">"), 2u);
+  EXPECT_EQ(count(svg, "h0"), 34u);  // every point of both panels
+  const auto dots = dotsByColour(svg);
+  EXPECT_EQ(dots.at("#b2182b"), 5u);
+  EXPECT_EQ(dots.at("#dddddd"), 6u);
+  EXPECT_EQ(dots.at("#2166ac"), 6u);
+  EXPECT_EQ(dots.at(divergingColour(0.1)), 17u);  // 0.05 mm = one step of limit / 10
+  EXPECT_NE(svg.find("data-limit-mm=\"0.5\""), std::string::npos);
+  EXPECT_NE(svg.find(">-0.5</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">0.5</text>"), std::string::npos);
+  EXPECT_NE(svg.find("signed distance (mm)"), std::string::npos);
+  EXPECT_NE(svg.find("superovoid: RMS 0.05 mm (best)"), std::string::npos);
+  EXPECT_NE(svg.find("x (mm) \u2192 P"), std::string::npos);
+  EXPECT_NE(svg.find("y (mm) \u2192 S"), std::string::npos);
+  EXPECT_NE(svg.find("LPS"), std::string::npos);
+  EXPECT_NE(svg.find("head &amp; neck"), std::string::npos);
+
+  // Automatic limit: the 98th percentile of |d| (0.98 of 0.01 .. 1.00) rounded up.
+  Eigen::VectorXd ramp = Eigen::VectorXd::LinSpaced(100, 0.01, 1.0);
+  Eigen::MatrixX3d line(100, 3);
+  for (int i = 0; i < 100; ++i) line.row(i) << 20, i * 0.1, 0;
+  const AzimuthalMap line_map = azimuthalEqualArea(line, Eigen::Vector3d::Zero());
+  const std::string auto_svg = errorMapSvg(line_map, {{"sphere", -ramp}}, ErrorMapOptions(), "");
+  EXPECT_NE(auto_svg.find("data-limit-mm=\"1\""), std::string::npos);
+  // Subsampling: every 4th of 100 points when at most 30 are drawn.
+  ErrorMapOptions sparse;
+  sparse.max_points = 30;
+  EXPECT_EQ(count(errorMapSvg(line_map, {{"sphere", ramp}}, sparse, ""), "h0"), 25u);
+
+  EXPECT_THROW(errorMapSvg(map, {{"sphere", ramp}}, options, ""), articula::InputError);
+  EXPECT_THROW(errorMapSvg(map, {}, options, ""), articula::InputError);
+  sparse.max_points = 0;
+  EXPECT_THROW(errorMapSvg(line_map, {{"sphere", ramp}}, sparse, ""), articula::InvalidParameter);
+}
+
+TEST(StudySvg, PairedLinesDotsAndMeans) {
+  StudyRms study;
+  study.subjects = {"s01", "s02", "s03"};
+  study.models = {"sphere", "ellipsoid", "superovoid"};
+  study.rms_mm.resize(3, 3);
+  study.rms_mm << 0.4, 0.2, 0.1,  //
+      0.3, 0.25, 0.2,             //
+      0.2, 0.1, NAN;
+  const std::string svg = studyRmsSvg(study, "study");
+  EXPECT_EQ(count(svg, "<g class=\"subject\">"), 3u);
+  EXPECT_EQ(count(svg, "</circle>"), 8u);  // one dot per finite value
+  EXPECT_EQ(count(svg, "fill=\"#555555\"><title>"), 3u);  // each subject's least RMS
+  EXPECT_NE(svg.find("<title>s01 superovoid: 0.1 mm</title>"), std::string::npos);
+  EXPECT_NE(svg.find("<title>s03 ellipsoid: 0.1 mm</title>"), std::string::npos);
+  EXPECT_NE(svg.find("<title>mean sphere: 0.3 mm (3 subjects)</title>"), std::string::npos);
+  EXPECT_NE(svg.find("<title>mean ellipsoid: 0.183 mm (3 subjects)</title>"), std::string::npos);
+  EXPECT_NE(svg.find("<title>mean superovoid: 0.15 mm (2 subjects)</title>"), std::string::npos);
+  EXPECT_NE(svg.find("RMS of the signed distances (mm)"), std::string::npos);
+  EXPECT_EQ(count(svg, "class=\"mean\""), 3u);
+  // s03 has no superovoid: its line ends at the ellipsoid (one M, one L).
+  const std::regex line("<g class=\"subject\">\n<path fill=\"none\" stroke=\"#9a9a9a\" d=\"([^\"]*)\"");
+  std::vector<std::string> d;
+  for (std::sregex_iterator it(svg.begin(), svg.end(), line), end; it != end; ++it) d.push_back((*it)[1]);
+  ASSERT_EQ(d.size(), 3u);
+  EXPECT_EQ(count(d[0], "L"), 2u);
+  EXPECT_EQ(count(d[2], "L"), 1u);
+  study.rms_mm.resize(2, 3);
+  EXPECT_THROW(studyRmsSvg(study, ""), articula::InputError);
 }
 
 TEST(PlyWriters, ColoursFollowTheBand) {

@@ -1,5 +1,6 @@
 #include "articula/pipeline/study.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -10,6 +11,7 @@
 #include "articula/core/log.hpp"
 #include "articula/pipeline/csv.hpp"
 #include "articula/pipeline/statistics.hpp"
+#include "articula/report/study_svg.hpp"
 
 namespace articula::pipeline {
 
@@ -35,6 +37,26 @@ struct ModelRow {
   nlohmann::json entry;  // the model's entry of results.json
   bool best = false;
 };
+
+// study.svg: RMS per model, subject by subject (subjects in manifest order).
+std::string studyFigure(const std::vector<ModelRow>& rows, const std::vector<std::string>& model_order,
+                        const fs::path& study_dir) {
+  report::StudyRms study;
+  study.models = model_order;
+  for (const auto& r : rows)
+    if (std::find(study.subjects.begin(), study.subjects.end(), r.subject) == study.subjects.end())
+      study.subjects.push_back(r.subject);
+  study.rms_mm = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(study.subjects.size()),
+                                           static_cast<Eigen::Index>(model_order.size()), NAN);
+  for (const auto& r : rows) {
+    const auto s = std::find(study.subjects.begin(), study.subjects.end(), r.subject) - study.subjects.begin();
+    const auto m = std::find(model_order.begin(), model_order.end(), r.model) - model_order.begin();
+    study.rms_mm(s, m) = r.entry.at("errors").value("rms_mm", NAN);
+  }
+  const std::string name = fs::absolute(study_dir).lexically_normal().filename().string();
+  return report::studyRmsSvg(study, "RMS of the fitted models across " + std::to_string(study.subjects.size()) +
+                                        " subjects" + (name.empty() ? "" : " (" + name + ")"));
+}
 
 }  // namespace
 
@@ -166,6 +188,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   writeFileAtomically(study_dir / "study_summary.csv", summary_csv);
   writeFileAtomically(study_dir / "study_status.csv", status_csv);
   writeFileAtomically(study_dir / "study.json", study.dump(2) + "\n");
+  if (!rows.empty()) writeFileAtomically(study_dir / "study.svg", studyFigure(rows, model_order, study_dir));
   return study;
 }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "articula/core/error.hpp"
+#include "svg.hpp"
 
 namespace articula::report {
 
@@ -23,22 +24,7 @@ Histogram histogram(const Eigen::VectorXd& d, double lower, double upper, int bi
   return h;
 }
 
-namespace {
-// Colours of thesis fig. 3.5 (yellow darkened to stay readable on white).
-const char* colour(size_t i) {
-  static const char* colours[] = {"#d62728", "#2ca02c", "#1f77b4", "#d4a017", "#000000", "#9467bd", "#8c564b"};
-  return colours[i % 7];
-}
-
-// A "nice" tick step for a range.
-double tickStep(double range, int target) {
-  const double raw = range / target;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10.0 * p;
-}
-}  // namespace
+using svg::tickStep;
 
 std::string histogramSvg(const std::vector<Series>& series, const std::string& title) {
   if (series.empty()) throw UsageError("histogram: expected at least one series");
@@ -72,10 +58,8 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
   auto Y = [&](double c) { return top + ph - c / y_max * ph; };
   std::ostringstream out;
   out << std::fixed << std::setprecision(2);
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
-      << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-      << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-      << "<text x=\"" << W / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" << title << "</text>\n";
+  out << svg::open(W, H) << "<text x=\"" << W / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">"
+      << svg::escape(title) << "</text>\n";
   // Axes, ticks and labels.
   out << "<line x1=\"" << left << "\" y1=\"" << top + ph << "\" x2=\"" << left + pw << "\" y2=\"" << top + ph
       << "\" stroke=\"black\"/>\n<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\""
@@ -98,7 +82,7 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
   // Step histograms and Gaussians.
   for (size_t k = 0; k < series.size(); ++k) {
     const Histogram& h = hists[k];
-    out << "<path fill=\"none\" stroke=\"" << colour(k) << "\" stroke-opacity=\"0.6\" d=\"M" << X(lo) << ',' << Y(0);
+    out << "<path fill=\"none\" stroke=\"" << svg::seriesColour(k) << "\" stroke-opacity=\"0.6\" d=\"M" << X(lo) << ',' << Y(0);
     for (size_t b = 0; b < h.counts.size(); ++b) {
       const double c = static_cast<double>(h.counts[b]);
       out << " L" << X(lo + b * h.bin_width) << ',' << Y(c) << " L" << X(lo + (b + 1) * h.bin_width) << ',' << Y(c);
@@ -106,7 +90,7 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
     out << " L" << X(hi) << ',' << Y(0) << "\"/>\n";
     const Series& s = series[k];
     if (s.sigma > 0.0) {
-      out << "<polyline fill=\"none\" stroke-width=\"2\" stroke=\"" << colour(k) << "\" points=\"";
+      out << "<polyline fill=\"none\" stroke-width=\"2\" stroke=\"" << svg::seriesColour(k) << "\" points=\"";
       const double scale = static_cast<double>(s.values.size()) * h.bin_width / (s.sigma * std::sqrt(2.0 * M_PI));
       for (int i = 0; i <= 200; ++i) {
         const double v = lo + (hi - lo) * i / 200.0;
@@ -115,9 +99,9 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
       out << "\"/>\n";
     }
     const double ly = top + 10 + 18.0 * static_cast<double>(k);
-    out << "<line x1=\"" << left + pw - 230 << "\" y1=\"" << ly << "\" x2=\"" << left + pw - 205 << "\" y2=\"" << ly
-        << "\" stroke-width=\"2\" stroke=\"" << colour(k) << "\"/><text x=\"" << left + pw - 200 << "\" y=\"" << ly + 4
-        << "\">" << s.label << std::setprecision(3) << " (mu " << s.mu << ", sigma " << s.sigma << " mm)"
+    out << "<line x1=\"" << left + pw - 320 << "\" y1=\"" << ly << "\" x2=\"" << left + pw - 295 << "\" y2=\"" << ly
+        << "\" stroke-width=\"2\" stroke=\"" << svg::seriesColour(k) << "\"/><text x=\"" << left + pw - 290 << "\" y=\"" << ly + 4
+        << "\">" << svg::escape(s.label) << std::setprecision(3) << " (mu " << s.mu << ", sigma " << s.sigma << " mm)"
         << std::setprecision(2) << "</text>\n";
   }
   out << "</svg>\n";

@@ -8,6 +8,8 @@
 //                      its RMS against the sphere's
 //   study_status.csv   one row per subject: status, exit code, message
 //   study.json         all of the above, with provenance
+//   study.svg          RMS per model for each subject, with the per-model means
+//                      (when at least one subject succeeded)
 #include <filesystem>
 #include <vector>
 
