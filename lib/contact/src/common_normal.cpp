@@ -169,7 +169,7 @@ bool solveCommonNormal(const Matrix6d& J, const Vector6d& rhs, Vector6d& x) {
   if (!(scale > 0.0) || !std::isfinite(scale)) return false;
   const double tiny = 1e-14 * scale;
   int pivot[2], keep[4], kept = 0;
-  double factor[4][2];  // row r of the top block minus factor * (row 4 + block) zeroes column pivot[block]
+  double factor[4][2], inv_gradient[2];  // row r of the top block minus factor * (row 4 + block) zeroes column pivot[block]
   for (int block = 0; block < 2; ++block) {
     const int row = 4 + block, c0 = 3 * block;
     int p = c0;
@@ -179,8 +179,8 @@ bool solveCommonNormal(const Matrix6d& J, const Vector6d& rhs, Vector6d& x) {
     pivot[block] = p;
     for (int k = c0; k < c0 + 3; ++k)
       if (k != p) keep[kept++] = k;
-    const double inv = 1.0 / J(row, p);
-    for (int r = 0; r < 4; ++r) factor[r][block] = J(r, p) * inv;
+    inv_gradient[block] = 1.0 / J(row, p);
+    for (int r = 0; r < 4; ++r) factor[r][block] = J(r, p) * inv_gradient[block];
   }
   double m[4][5];  // the reduced system [M | b] over the unknowns keep[0..3]
   for (int r = 0; r < 4; ++r) {
@@ -216,7 +216,7 @@ bool solveCommonNormal(const Matrix6d& J, const Vector6d& rhs, Vector6d& x) {
     double sum = rhs[row];
     for (int k = 3 * block; k < 3 * block + 3; ++k)
       if (k != p) sum -= J(row, k) * x[k];
-    x[p] = sum / J(row, p);
+    x[p] = sum * inv_gradient[block];
   }
   return x.allFinite();
 }
