@@ -5,8 +5,11 @@
 // (for ellipsoids h(v) = v . c + sqrt(v' M v), M = R D^2 R^T), which is the
 // signed distance (minus the penetration depth on overlap), in long double: a
 // dense Fibonacci sample of v, then an adaptive hill climb from the best
-// `starts` samples. Superellipsoid support points come from plain Newton on
-// the convex Lagrange equation in long double. Shares no code with the solvers.
+// `starts` samples, each polished by Gauss-Newton on the common-normal
+// conditions in canonical coordinates (central differences; kept only when it
+// reaches a contact pair, whose distance is a value of the dual). Superellipsoid
+// support points come from plain Newton on the convex Lagrange equation in
+// long double. Shares no code with the solvers.
 #include "articula/contact/convex_shape.hpp"
 
 namespace articula::contact {
