@@ -1,6 +1,8 @@
-// bench-contact: minimum signed distance between random ellipsoid pairs
-// (uniform random orientations; semi-axes 0.5-1.5, and a set with aspect up
-// to 10: 0.15-1.5), 2,000 pairs per class:
+// bench-contact: minimum signed distance between random convex pairs
+// (uniform random orientations), three sets:
+//   ellipsoids with semi-axes 0.5-1.5 and with aspect up to 10 (0.15-1.5), 2,000 pairs per class;
+//   superellipsoids (thesis form, exponents 2-4, semi-axes 0.5-1.5), 400 pairs per class;
+// classes:
 //   separated: reference distance > 0 (placed with a gap of 0.01-1 mm along a random direction),
 //   shallow:   penetration depth 0-0.05 mm (reference in [-0.05, 0)),
 //   deep:      penetration depth > 0.05 mm (placed with an overlap of 0.1-1 mm along a random direction).
@@ -11,11 +13,11 @@
 // max_err / p99_err (mm, against the reference), failures (error > 1e-3 or
 // no answer), answered (pairs the method gave a distance for).
 // Peers: Simbody's ContactTracker::ConvexImplicitPair (the same six equations,
-// reports overlap only), libccd GJK+EPA and MPR (penetration only; an exact
-// ellipsoid support function), FCL's fcl::distance with signed distance
+// reports overlap only; ellipsoids), libccd GJK+EPA and MPR (penetration only;
+// our exact support function), FCL's fcl::distance with signed distance
 // (its Ellipsoid shape, libccd GJK/EPA inside, tolerance 1e-6: Debian's build
 // asserts at tighter ones) and Bullet's btGjkEpaSolver2::SignedDistance in
-// double precision (an exact ellipsoid support function, margin 0).
+// double precision (our exact support function, margin 0).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -41,8 +43,10 @@ namespace {
 using namespace articula::contact;
 using Eigen::Vector3d;
 
-constexpr int kPairs = 2000;
+constexpr int kPairs = 2000;       // per class, ellipsoids
+constexpr int kSuperPairs = 400;   // per class, superellipsoids (the reference is slower)
 const char* kClassNames[3] = {"separated", "shallow", "deep"};
+const char* kSetNames[3] = {", axes 0.5-1.5", ", aspect<=10", ", superellipsoids g 2-4"};
 
 struct Pair {
   ConvexShape a, b;
@@ -50,25 +54,27 @@ struct Pair {
   ContactResult previous;  // solution one small motion step earlier (warm start)
 };
 
-std::vector<Pair> makePairs(int cls, int aspect) {
-  std::mt19937_64 rng(1000 + 10 * cls + aspect);
+// set: 0 ellipsoids, axes 0.5-1.5; 1 ellipsoids, aspect <= 10; 2 superellipsoids, exponents 2-4.
+std::vector<Pair> makePairs(int cls, int set) {
+  std::mt19937_64 rng(1000 + 10 * cls + set);
   std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> radius(aspect ? 0.15 : 0.5, 1.5);
-  const double lo[3] = {0.01, -0.1, -1.0}, hi[3] = {1.0, 0.0, -0.1};
+  std::uniform_real_distribution<double> radius(set == 1 ? 0.15 : 0.5, 1.5), exponent(2.0, 4.0);
+  const double lo[3] = {0.01, set == 2 ? -0.05 : -0.1, -1.0}, hi[3] = {1.0, 0.0, -0.1};
   std::uniform_real_distribution<double> gap(lo[cls], hi[cls]);
   auto shape = [&] {
-    return makeConvexShape(Vector3d::Zero(),
-                           Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix(),
-                           Vector3d(radius(rng), radius(rng), radius(rng)));
+    const Eigen::Matrix3d R = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    const Vector3d radii(radius(rng), radius(rng), radius(rng));
+    if (set < 2) return makeConvexShape(Vector3d::Zero(), R, radii);
+    return makeConvexShape(Vector3d::Zero(), R, radii, Vector3d(exponent(rng), exponent(rng), exponent(rng)));
   };
   std::vector<Pair> pairs;
-  while (static_cast<int>(pairs.size()) < kPairs) {
+  while (static_cast<int>(pairs.size()) < (set == 2 ? kSuperPairs : kPairs)) {
     Pair p{shape(), shape(), 0.0, {}};
     const Vector3d dir = Vector3d(g(rng), g(rng), g(rng)).normalized();
     const double ea = dir.dot(toGlobal(p.a, supportCanonical(p.a, dir)));
     const double eb = -dir.dot(toGlobal(p.b, supportCanonical(p.b, -dir)));
     p.b.center = dir * (ea + eb + gap(rng));
-    p.reference = referenceEllipsoidDistance(p.a, p.b, 1500, 4);
+    p.reference = referenceConvexDistance(p.a, p.b, 1500, 4);
     const bool in_class = cls == 0 ? p.reference > 0.0 : cls == 1 ? p.reference >= -0.05 && p.reference < 0.0
                                                                   : p.reference < -0.05;
     if (!in_class) continue;
@@ -82,10 +88,10 @@ std::vector<Pair> makePairs(int cls, int aspect) {
   return pairs;
 }
 
-const std::vector<Pair>& pairSet(int cls, int aspect) {
-  static std::vector<Pair> sets[3][2];
-  if (sets[cls][aspect].empty()) sets[cls][aspect] = makePairs(cls, aspect);
-  return sets[cls][aspect];
+const std::vector<Pair>& pairSet(int cls, int set) {
+  static std::vector<Pair> sets[3][3];
+  if (sets[cls][set].empty()) sets[cls][set] = makePairs(cls, set);
+  return sets[cls][set];
 }
 
 // A method answers a pair with a signed distance, or NaN for "no answer".
@@ -122,7 +128,7 @@ void accuracyCounters(benchmark::State& state, const std::vector<Pair>& pairs, c
 
 void runMethod(benchmark::State& state, const Method& method) {
   const auto& pairs = pairSet(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  state.SetLabel(std::string(kClassNames[state.range(0)]) + (state.range(1) ? ", aspect<=10" : ", axes 0.5-1.5"));
+  state.SetLabel(std::string(kClassNames[state.range(0)]) + kSetNames[state.range(1)]);
   size_t i = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(method(pairs[i]));
@@ -168,23 +174,23 @@ void BM_Simbody(benchmark::State& state) {
 }
 
 // ---------------------------------------------------------------- libccd
-void ellipsoidSupport(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
+void shapeSupport(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
   const ConvexShape& s = *static_cast<const ConvexShape*>(obj);
   const Vector3d v(dir->v[0], dir->v[1], dir->v[2]);
   const Vector3d x = toGlobal(s, supportCanonical(s, v));
   ccdVec3Set(out, x[0], x[1], x[2]);
 }
-void ellipsoidCenter(const void* obj, ccd_vec3_t* out) {
+void shapeCenter(const void* obj, ccd_vec3_t* out) {
   const ConvexShape& s = *static_cast<const ConvexShape*>(obj);
   ccdVec3Set(out, s.center[0], s.center[1], s.center[2]);
 }
 ccd_t ccdSetup() {
   ccd_t ccd;
   CCD_INIT(&ccd);
-  ccd.support1 = ellipsoidSupport;
-  ccd.support2 = ellipsoidSupport;
-  ccd.center1 = ellipsoidCenter;
-  ccd.center2 = ellipsoidCenter;
+  ccd.support1 = shapeSupport;
+  ccd.support2 = shapeSupport;
+  ccd.center1 = shapeCenter;
+  ccd.center2 = shapeCenter;
   ccd.max_iterations = 1000;
   return ccd;
 }
@@ -223,15 +229,18 @@ void BM_Fcl(benchmark::State& state) {
 }
 
 // ---------------------------------------------------------------- Bullet (double precision)
-// An ellipsoid with the exact support mapping x = D^2 v / |D v| (local axes), margin 0.
-class BulletEllipsoid : public btConvexInternalShape {
+// An (super)ellipsoid with our exact support mapping (local axes), margin 0.
+class BulletShape : public btConvexInternalShape {
  public:
-  explicit BulletEllipsoid(const Vector3d& radii) : radii_(radii) { setMargin(0.0); }
+  explicit BulletShape(const ConvexShape& s) : local_(s) {
+    local_.center.setZero();
+    local_.rotation.setIdentity();
+    setMargin(0.0);
+  }
   btVector3 localGetSupportingVertexWithoutMargin(const btVector3& v) const override {
-    const Vector3d w = radii_.cwiseProduct(Vector3d(v.x(), v.y(), v.z()));
-    const double len = w.norm();
-    if (!(len > 0.0)) return btVector3(radii_[0], 0.0, 0.0);
-    const Vector3d x = radii_.cwiseProduct(w) / len;
+    const Vector3d w(v.x(), v.y(), v.z());
+    if (!(w.norm() > 0.0)) return btVector3(local_.radii[0], 0.0, 0.0);
+    const Vector3d x = toGlobal(local_, supportCanonical(local_, w));
     return btVector3(x[0], x[1], x[2]);
   }
   btVector3 localGetSupportingVertex(const btVector3& v) const override {
@@ -242,10 +251,10 @@ class BulletEllipsoid : public btConvexInternalShape {
   }
   void getAabb(const btTransform& t, btVector3& lo, btVector3& hi) const override { getAabbSlow(t, lo, hi); }
   void calculateLocalInertia(btScalar, btVector3& inertia) const override { inertia.setZero(); }
-  const char* getName() const override { return "ArticulaEllipsoid"; }
+  const char* getName() const override { return "ArticulaConvexShape"; }
 
  private:
-  Vector3d radii_;
+  ConvexShape local_;
 };
 void BM_Bullet(benchmark::State& state) {
   auto transform = [](const ConvexShape& s) {
@@ -254,7 +263,7 @@ void BM_Bullet(benchmark::State& state) {
                        btVector3(s.center[0], s.center[1], s.center[2]));
   };
   runMethod(state, [&](const Pair& p) -> double {
-    const BulletEllipsoid ea(p.a.radii), eb(p.b.radii);
+    const BulletShape ea(p.a), eb(p.b);
     btGjkEpaSolver2::sResults results;
     const Vector3d guess = p.b.center - p.a.center;
     // Distance (GJK) when separated, else Penetration (EPA): distance < 0.
@@ -301,17 +310,22 @@ void BM_SuperellipsoidPlane(benchmark::State& state) {
 }
 BENCHMARK(BM_SuperellipsoidPlane);
 
-void classes(benchmark::internal::Benchmark* b) {
-  for (int aspect : {0, 1})
-    for (int cls : {0, 1, 2}) b->Args({cls, aspect});
+// Args {class, set}; Simbody and FCL take ellipsoids only.
+void ellipsoidClasses(benchmark::internal::Benchmark* b) {
+  for (int set : {0, 1})
+    for (int cls : {0, 1, 2}) b->Args({cls, set});
 }
-BENCHMARK(BM_OursCold)->Apply(classes);
-BENCHMARK(BM_OursWarm)->Apply(classes);
-BENCHMARK(BM_Simbody)->Apply(classes);
-BENCHMARK(BM_LibccdGjkEpa)->Apply(classes);
-BENCHMARK(BM_LibccdMpr)->Apply(classes);
-BENCHMARK(BM_Fcl)->Apply(classes);
-BENCHMARK(BM_Bullet)->Apply(classes);
+void allClasses(benchmark::internal::Benchmark* b) {
+  for (int set : {0, 1, 2})
+    for (int cls : {0, 1, 2}) b->Args({cls, set});
+}
+BENCHMARK(BM_OursCold)->Apply(allClasses);
+BENCHMARK(BM_OursWarm)->Apply(allClasses);
+BENCHMARK(BM_Simbody)->Apply(ellipsoidClasses);
+BENCHMARK(BM_LibccdGjkEpa)->Apply(allClasses);
+BENCHMARK(BM_LibccdMpr)->Apply(allClasses);
+BENCHMARK(BM_Fcl)->Apply(ellipsoidClasses);
+BENCHMARK(BM_Bullet)->Apply(allClasses);
 
 }  // namespace
 

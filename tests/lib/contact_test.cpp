@@ -304,6 +304,35 @@ TEST(Contact, SuperellipsoidPairsAreGlobalCommonNormalPairs) {
   }
 }
 
+// About 100 superellipsoid pairs (exponents 2-4) against the long-double
+// reference, cold and warm-started from one small motion step earlier (a
+// smaller version of bench-contact's superellipsoid classes).
+TEST(Contact, SuperellipsoidPairsAgainstReference) {
+  std::mt19937_64 rng(10);
+  std::normal_distribution<double> g;
+  for (const PairClass& c : {PairClass{"separated", 0.01, 1.0}, PairClass{"shallow", -0.05, 0.0},
+                             PairClass{"deep", -1.0, -0.1}}) {
+    std::uniform_real_distribution<double> gap(c.gap_min, c.gap_max);
+    double worst_cold = 0.0, worst_warm = 0.0;
+    for (int i = 0; i < 34; ++i) {
+      ConvexShape a = randomShape(rng, 0.5, 1.5, 4.0), b = randomShape(rng, 0.5, 1.5, 4.0);
+      placeAt(a, b, rng, gap(rng));
+      const double ref = referenceConvexDistance(a, b, 1500, 4);
+      ConvexShape before = b;
+      before.center += 0.01 * Vector3d(g(rng), g(rng), g(rng)).normalized();
+      before.rotation = Eigen::AngleAxisd(0.01, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+      const ContactResult previous = computeContact(a, before);
+      const ContactResult cold = computeContact(a, b), warm = computeContact(a, b, {}, &previous);
+      EXPECT_EQ(cold.summary.status, ContactStatus::Converged) << c.name << " " << cold.summary.briefReport();
+      EXPECT_NEAR(cold.distance, ref, 1e-9) << c.name << " pair " << i << ": " << cold.summary.briefReport();
+      EXPECT_NEAR(warm.distance, ref, 1e-9) << c.name << " pair " << i << ": " << warm.summary.briefReport();
+      worst_cold = std::max(worst_cold, std::fabs(cold.distance - ref));
+      worst_warm = std::max(worst_warm, std::fabs(warm.distance - ref));
+    }
+    std::printf("  %s: worst |error| cold %.3g mm, warm %.3g mm\n", c.name, worst_cold, worst_warm);
+  }
+}
+
 TEST(Contact, SymmetricConfigurationsWithSeveralSolutions) {
   // Fig. 5.13: a sphere and an aligned ellipsoid along a symmetry axis; the
   // centre start sits exactly on a common-normal solution.

@@ -69,36 +69,67 @@ PointData pointData(const ConvexShape& s, const Vector3d& u) {
 
 // d n / d u for the unit normal: (I - n n^T) / |g| * R D^-1 diag(H_l).
 Matrix3d unitNormalJacobian(const ConvexShape& s, const PointData& p) {
-  const Matrix3d A = s.rotation * s.radii.cwiseInverse().asDiagonal();
-  return (Matrix3d::Identity() - p.n * p.n.transpose()) / p.normal_len * A * p.e.hessian_diagonal.asDiagonal();
+  const Matrix3d m = s.rotation * p.e.hessian_diagonal.cwiseQuotient(s.radii).asDiagonal();
+  return (m - p.n * (p.n.transpose() * m)) / p.normal_len;
+}
+
+}  // namespace
+
+namespace {
+
+// The residual's pieces at (u_A, u_B), kept so that the Jacobian (needed only
+// for a step, not for a line-search trial or the final check) and the answer
+// reuse them without evaluating the powers again.
+struct SystemPoint {
+  PointData pa, pb;
+  FrameWithDerivatives f;
+  Vector3d d;
+};
+
+void residual(const ConvexShape& a, const ConvexShape& b, const Vector3d& u_a, const Vector3d& u_b,
+              geometry::FrameMethod frame, double inv_l, SystemPoint& p, Vector6d& phi) {
+  p.pa = pointData(a, u_a);
+  p.pb = pointData(b, u_b);
+  p.f = frameWithDerivatives(p.pb.n, frame);
+  p.d = p.pb.x - p.pa.x;
+  phi << p.pa.n.dot(p.f.t), p.pa.n.dot(p.f.b), p.d.dot(p.f.t) * inv_l, p.d.dot(p.f.b) * inv_l, p.pa.e.value,
+      p.pb.e.value;
+}
+
+void jacobian(const ConvexShape& a, const ConvexShape& b, const SystemPoint& p, double inv_l, Matrix6d& J) {
+  const FrameWithDerivatives& f = p.f;
+  const Matrix3d dna = unitNormalJacobian(a, p.pa);
+  const Matrix3d dnb = unitNormalJacobian(b, p.pb);
+  // Rows through d t / d u_B = dt_dn dnb (and b): vector-matrix products only.
+  using Row = Eigen::RowVector3d;
+  const Row na_dt = (p.pa.n.transpose() * f.dt_dn) * dnb, na_db = (p.pa.n.transpose() * f.db_dn) * dnb;
+  const Row d_dt = (p.d.transpose() * f.dt_dn) * dnb, d_db = (p.d.transpose() * f.db_dn) * dnb;
+  // t^T R D = (R^T t)^T D.
+  const Row ta = (a.rotation.transpose() * f.t).cwiseProduct(a.radii).transpose();
+  const Row ba = (a.rotation.transpose() * f.b).cwiseProduct(a.radii).transpose();
+  const Row tb = (b.rotation.transpose() * f.t).cwiseProduct(b.radii).transpose();
+  const Row bb = (b.rotation.transpose() * f.b).cwiseProduct(b.radii).transpose();
+  J.block<1, 3>(0, 0) = f.t.transpose() * dna;
+  J.block<1, 3>(0, 3) = na_dt;
+  J.block<1, 3>(1, 0) = f.b.transpose() * dna;
+  J.block<1, 3>(1, 3) = na_db;
+  J.block<1, 3>(2, 0) = -ta * inv_l;
+  J.block<1, 3>(2, 3) = (tb + d_dt) * inv_l;
+  J.block<1, 3>(3, 0) = -ba * inv_l;
+  J.block<1, 3>(3, 3) = (bb + d_db) * inv_l;
+  J.block<1, 3>(4, 0) = p.pa.e.gradient.transpose();
+  J.block<1, 3>(4, 3).setZero();
+  J.block<1, 3>(5, 0).setZero();
+  J.block<1, 3>(5, 3) = p.pb.e.gradient.transpose();
 }
 
 }  // namespace
 
 void commonNormalSystem(const ConvexShape& a, const ConvexShape& b, const Vector3d& u_a, const Vector3d& u_b,
                         geometry::FrameMethod frame, double length, Vector6d& phi, Matrix6d& J) {
-  const PointData pa = pointData(a, u_a), pb = pointData(b, u_b);
-  const FrameWithDerivatives f = frameWithDerivatives(pb.n, frame);
-  const Vector3d d = pb.x - pa.x;
-  const double inv_l = 1.0 / length;
-  phi << pa.n.dot(f.t), pa.n.dot(f.b), d.dot(f.t) * inv_l, d.dot(f.b) * inv_l, pa.e.value, pb.e.value;
-
-  const Matrix3d dna = unitNormalJacobian(a, pa);
-  const Matrix3d dnb = unitNormalJacobian(b, pb);
-  const Matrix3d dt = f.dt_dn * dnb, db = f.db_dn * dnb;
-  const Matrix3d Ba = a.rotation * a.radii.asDiagonal(), Bb = b.rotation * b.radii.asDiagonal();
-  J.block<1, 3>(0, 0) = f.t.transpose() * dna;
-  J.block<1, 3>(0, 3) = pa.n.transpose() * dt;
-  J.block<1, 3>(1, 0) = f.b.transpose() * dna;
-  J.block<1, 3>(1, 3) = pa.n.transpose() * db;
-  J.block<1, 3>(2, 0) = -f.t.transpose() * Ba * inv_l;
-  J.block<1, 3>(2, 3) = (f.t.transpose() * Bb + d.transpose() * dt) * inv_l;
-  J.block<1, 3>(3, 0) = -f.b.transpose() * Ba * inv_l;
-  J.block<1, 3>(3, 3) = (f.b.transpose() * Bb + d.transpose() * db) * inv_l;
-  J.block<1, 3>(4, 0) = pa.e.gradient.transpose();
-  J.block<1, 3>(4, 3).setZero();
-  J.block<1, 3>(5, 0).setZero();
-  J.block<1, 3>(5, 3) = pb.e.gradient.transpose();
+  SystemPoint p;
+  residual(a, b, u_a, u_b, frame, 1.0 / length, p, phi);
+  jacobian(a, b, p, 1.0 / length, J);
 }
 
 double dualSeparation(const ConvexShape& a, const ConvexShape& b, const Vector3d& v, Vector3d* u_a, Vector3d* u_b) {
@@ -125,34 +156,67 @@ const std::vector<Vector3d>& sphereDirections(int count) {
   return cache;
 }
 
-// Solves J x = rhs by Gaussian elimination with partial pivoting; false when a
-// pivot falls below 1e-14 of the largest entry (singular to working precision).
-// Hand-written: Eigen's PartialPivLU takes its blocked dynamic-size path even
-// for a fixed 6x6, and with rcond() it was most of the solver's time (perf).
-bool solve6(Matrix6d J, Vector6d rhs, Vector6d& x) {
+// Solves J x = rhs for the common-normal Jacobian, whose rows 4 and 5 are
+// [grad F_A, 0] and [0, grad F_B]: each of them eliminates one unknown of its
+// point (the largest gradient component, a safe pivot), which leaves a 4x4
+// system for Gaussian elimination with partial pivoting (a third of the work
+// of the dense 6x6). False when a pivot falls below 1e-14 of the largest
+// entry (singular to working precision). Hand-written: Eigen's PartialPivLU
+// takes its blocked dynamic-size path even for a fixed 6x6, and with rcond()
+// it was most of the solver's time (perf).
+bool solveCommonNormal(const Matrix6d& J, const Vector6d& rhs, Vector6d& x) {
   const double scale = J.cwiseAbs().maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) return false;
-  for (int k = 0; k < 6; ++k) {
-    int p = k;
-    for (int i = k + 1; i < 6; ++i)
-      if (std::fabs(J(i, k)) > std::fabs(J(p, k))) p = i;
-    if (!(std::fabs(J(p, k)) > 1e-14 * scale)) return false;
-    if (p != k) {
-      J.row(p).swap(J.row(k));
-      std::swap(rhs[p], rhs[k]);
+  const double tiny = 1e-14 * scale;
+  int pivot[2], keep[4], kept = 0;
+  double factor[4][2], inv_gradient[2];  // row r of the top block minus factor * (row 4 + block) zeroes column pivot[block]
+  for (int block = 0; block < 2; ++block) {
+    const int row = 4 + block, c0 = 3 * block;
+    int p = c0;
+    for (int k = c0 + 1; k < c0 + 3; ++k)
+      if (std::fabs(J(row, k)) > std::fabs(J(row, p))) p = k;
+    if (!(std::fabs(J(row, p)) > tiny)) return false;
+    pivot[block] = p;
+    for (int k = c0; k < c0 + 3; ++k)
+      if (k != p) keep[kept++] = k;
+    inv_gradient[block] = 1.0 / J(row, p);
+    for (int r = 0; r < 4; ++r) factor[r][block] = J(r, p) * inv_gradient[block];
+  }
+  double m[4][5];  // the reduced system [M | b] over the unknowns keep[0..3]
+  for (int r = 0; r < 4; ++r) {
+    for (int j = 0; j < 4; ++j) {
+      const int block = keep[j] / 3;
+      m[r][j] = J(r, keep[j]) - factor[r][block] * J(4 + block, keep[j]);
     }
-    const double inv = 1.0 / J(k, k);
-    for (int i = k + 1; i < 6; ++i) {
-      const double f = J(i, k) * inv;
-      if (f == 0.0) continue;
-      for (int j = k + 1; j < 6; ++j) J(i, j) -= f * J(k, j);
-      rhs[i] -= f * rhs[k];
+    m[r][4] = rhs[r] - factor[r][0] * rhs[4] - factor[r][1] * rhs[5];
+  }
+  double inv_pivot[4];
+  for (int k = 0; k < 4; ++k) {
+    int p = k;
+    for (int i = k + 1; i < 4; ++i)
+      if (std::fabs(m[i][k]) > std::fabs(m[p][k])) p = i;
+    if (!(std::fabs(m[p][k]) > tiny)) return false;
+    if (p != k)
+      for (int j = k; j < 5; ++j) std::swap(m[p][j], m[k][j]);
+    inv_pivot[k] = 1.0 / m[k][k];
+    for (int i = k + 1; i < 4; ++i) {
+      const double f = m[i][k] * inv_pivot[k];
+      for (int j = k + 1; j < 5; ++j) m[i][j] -= f * m[k][j];
     }
   }
-  for (int k = 5; k >= 0; --k) {
-    double sum = rhs[k];
-    for (int j = k + 1; j < 6; ++j) sum -= J(k, j) * x[j];
-    x[k] = sum / J(k, k);
+  double y[4];
+  for (int k = 3; k >= 0; --k) {
+    double sum = m[k][4];
+    for (int j = k + 1; j < 4; ++j) sum -= m[k][j] * y[j];
+    y[k] = sum * inv_pivot[k];
+  }
+  for (int j = 0; j < 4; ++j) x[keep[j]] = y[j];
+  for (int block = 0; block < 2; ++block) {
+    const int row = 4 + block, p = pivot[block];
+    double sum = rhs[row];
+    for (int k = 3 * block; k < 3 * block + 3; ++k)
+      if (k != p) sum -= J(row, k) * x[k];
+    x[p] = sum * inv_gradient[block];
   }
   return x.allFinite();
 }
@@ -167,17 +231,36 @@ struct Solver {
   // Best answer so far (largest signed distance among converged starts).
   bool have = false;
   double best = -std::numeric_limits<double>::infinity();
-  Vector3d best_ua = Vector3d::Zero(), best_ub = Vector3d::Zero();
+  Vector3d best_ua = Vector3d::Zero(), best_ub = Vector3d::Zero(), best_normal = Vector3d::UnitX();
   double best_residual = 0.0;
 
   // Damped Newton from (u_a, u_b); on success records the candidate and returns its distance.
   bool newton(Vector3d u_a, Vector3d u_b, double* distance) {
     ++summary.starts;
+    const double inv_l = 1.0 / length;
     Vector6d q, phi, trial_phi, delta;
     q << u_a, u_b;
-    Matrix6d J, trial_J;
-    commonNormalSystem(a, b, q.head<3>(), q.tail<3>(), options.frame, length, phi, J);
-    if (!phi.allFinite() || !J.allFinite()) return false;
+    Matrix6d J;
+    SystemPoint point, trial_point;
+    residual(a, b, q.head<3>(), q.tail<3>(), options.frame, inv_l, point, phi);
+    if (!phi.allFinite()) return false;
+    bool have_jacobian = false;
+    auto needJacobian = [&] {
+      if (!have_jacobian) jacobian(a, b, point, inv_l, J);
+      have_jacobian = true;
+      return J.allFinite();
+    };
+    // A trial point replaces the current one when it lowers the merit enough.
+    auto tryPoint = [&](const Vector6d& trial, double required) {
+      residual(a, b, trial.head<3>(), trial.tail<3>(), options.frame, inv_l, trial_point, trial_phi);
+      const double trial_merit = trial_phi.squaredNorm();
+      if (!(trial_phi.allFinite() && trial_merit <= required)) return false;
+      q = trial;
+      phi = trial_phi;
+      std::swap(point, trial_point);
+      have_jacobian = false;
+      return true;
+    };
     double merit = phi.squaredNorm();
     bool converged = false;
     for (int it = 0; it < options.max_iterations; ++it) {
@@ -185,27 +268,22 @@ struct Solver {
         converged = true;
         break;
       }
+      if (!needJacobian()) return false;
       ++summary.iterations;
       bool accepted = false;
-      if (solve6(J, -phi, delta)) {
+      if (solveCommonNormal(J, -phi, delta)) {
         const double norm = delta.norm();
         if (norm > 0.5) delta *= 0.5 / norm;  // a point never needs to move more than this at once
         for (double alpha = 1.0; alpha >= 1.0 / 64.0; alpha *= 0.5) {
-          const Vector6d trial = q + alpha * delta;
-          commonNormalSystem(a, b, trial.head<3>(), trial.tail<3>(), options.frame, length, trial_phi, trial_J);
-          const double trial_merit = trial_phi.squaredNorm();
-          if (trial_phi.allFinite() && trial_merit <= (1.0 - 1e-4 * alpha) * merit) {
+          if (tryPoint(q + alpha * delta, (1.0 - 1e-4 * alpha) * merit)) {
             delta *= alpha;
-            q = trial;
-            phi = trial_phi;
-            J = trial_J;
-            merit = trial_merit;
             accepted = true;
             break;
           }
         }
       }
-      if (!accepted) {
+      const bool damped = !accepted;
+      if (damped) {
         // Levenberg-Marquardt: singular Jacobian, or a Newton direction that does not descend.
         const Matrix6d JtJ = J.transpose() * J;
         const Vector6d g = J.transpose() * phi;
@@ -214,16 +292,7 @@ struct Solver {
           Matrix6d M = JtJ;
           M.diagonal().array() += mu;
           delta = -M.ldlt().solve(g);
-          const Vector6d trial = q + delta;
-          commonNormalSystem(a, b, trial.head<3>(), trial.tail<3>(), options.frame, length, trial_phi, trial_J);
-          const double trial_merit = trial_phi.squaredNorm();
-          if (trial_phi.allFinite() && trial_merit < merit) {
-            q = trial;
-            phi = trial_phi;
-            J = trial_J;
-            merit = trial_merit;
-            accepted = true;
-          }
+          accepted = tryPoint(q + delta, std::nextafter(merit, 0.0));
         }
         ++summary.damped_steps;
         if (!accepted) {
@@ -232,23 +301,25 @@ struct Solver {
           break;
         }
       }
-      if (delta.norm() <= options.step_tolerance) {
+      merit = phi.squaredNorm();
+      // A tiny Levenberg-Marquardt step (large damping) says nothing about convergence.
+      if (!damped && delta.norm() <= options.step_tolerance) {
         converged = true;
         break;
       }
     }
     if (!converged && std::sqrt(merit) <= 1e-11) converged = true;  // iteration cap at rounding level
     if (!converged) return false;
-    const PointData pa = pointData(a, q.head<3>()), pb = pointData(b, q.tail<3>());
-    if (pa.n.dot(pb.n) > -0.5) return false;  // parallel normals, same sense: not a contact pair
-    const Vector3d d = pb.x - pa.x;
-    const double signed_distance = std::copysign(d.norm(), pa.n.dot(d));
+    const PointData& pa = point.pa;
+    if (pa.n.dot(point.pb.n) > -0.5) return false;  // parallel normals, same sense: not a contact pair
+    const double signed_distance = std::copysign(point.d.norm(), pa.n.dot(point.d));
     if (distance) *distance = signed_distance;
     if (!have || signed_distance > best) {
       have = true;
       best = signed_distance;
       best_ua = q.head<3>();
       best_ub = q.tail<3>();
+      best_normal = pa.n;
       best_residual = std::sqrt(merit);
     }
     return true;
@@ -339,6 +410,7 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
         solver.best = s_climb;
         solver.best_ua = ua;
         solver.best_ub = ub;
+        solver.best_normal = a.rotation * evaluateCanonical(a, ua).gradient.cwiseQuotient(a.radii).normalized();
         hill_climb_answer = true;
         summary.termination = "no Newton start converged to the dual maximum; dual hill climb answer";
       }
@@ -353,8 +425,7 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
   result.canonical_b = solver.best_ub;
   result.point_a = toGlobal(a, solver.best_ua);
   result.point_b = toGlobal(b, solver.best_ub);
-  const Vector3d g = a.rotation * evaluateCanonical(a, solver.best_ua).gradient.cwiseQuotient(a.radii);
-  result.normal = g.normalized();
+  result.normal = solver.best_normal;
   const Vector3d d = result.point_b - result.point_a;
   result.distance = std::copysign(d.norm(), result.normal.dot(d));
   summary.certified = result.distance > 0.0 && summary.status == ContactStatus::Converged;
