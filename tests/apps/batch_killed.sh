@@ -3,7 +3,8 @@
 # group, as a cluster's preemption or a closed terminal does) resumes: the
 # finished subject is not redone, the interrupted one is redone from
 # scratch, no temporary file is left behind, and the study tables equal
-# those of an uninterrupted batch.
+# those of an uninterrupted batch. The study selects each phantom's true
+# model (sphere, ellipsoid, superellipsoid) as the one its points support.
 source "$(dirname "$0")/common.bash"
 
 models=(sphere ellipsoid superellipsoid)
@@ -38,4 +39,13 @@ leftovers=$(find "$tmp/killed" -name '.tmp-*')
 [ -z "$leftovers" ] || fail "temporary files left behind: $leftovers"
 diff "$tmp/reference/study.csv" "$tmp/killed/study.csv" || fail "study.csv differs from an uninterrupted batch"
 diff "$tmp/reference/study_summary.csv" "$tmp/killed/study_summary.csv" || fail "study_summary.csv differs"
+python3 - "$tmp/killed" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(f"{sys.argv[1]}/study.csv")))
+selected = {r["subject"]: r["model"] for r in rows if r["selected"] == "1"}
+assert selected == {"s1": "sphere", "s2": "ellipsoid", "s3": "superellipsoid"}, selected
+summary = {r["model"]: r for r in csv.DictReader(open(f"{sys.argv[1]}/study_summary.csv"))}
+assert [summary[m]["times_selected"] for m in ("sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid")] == \
+    ["1", "1", "1", "0", "0"], summary
+PY
 echo "killed batch resumed: ok"

@@ -213,3 +213,32 @@ TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
   EXPECT_FALSE(has("bad"));
   EXPECT_LT(svg.find("<title>s2 sphere"), svg.find("<title>s1 sphere"));  // manifest order
 }
+
+namespace articula {
+namespace {
+
+TEST(ModelSelection, TheSimplestModelWithinTheToleranceOfTheLeastRms) {
+  // The RMS of tests/apps/batch_killed.sh's true sphere: the ovoids are 8 %
+  // better, which the tolerance does not count as a difference.
+  const std::vector<pipeline::ModelScore> sphere_truth = {{"sphere", 4, 0.1261}, {"ellipsoid", 9, 0.1212},
+                                                          {"superellipsoid", 12, 0.1212}, {"ovoid", 15, 0.1165},
+                                                          {"superovoid", 18, 0.1160}};
+  pipeline::ModelSelection s = pipeline::selectParsimonious(sphere_truth);
+  EXPECT_EQ(s.selected, "sphere");
+  EXPECT_EQ(s.indistinguishable.size(), 5u);
+  // A clear superellipsoid: the ellipsoid is 54 % worse, the ovoid 16 %.
+  s = pipeline::selectParsimonious({{"sphere", 4, 0.325}, {"ellipsoid", 9, 0.169}, {"superellipsoid", 12, 0.1105},
+                                    {"ovoid", 15, 0.128}, {"superovoid", 18, 0.1100}});
+  EXPECT_EQ(s.selected, "superellipsoid");
+  EXPECT_EQ(s.indistinguishable, (std::vector<std::string>{"superellipsoid", "superovoid"}));
+  // A 1 % tolerance keeps only the ovoids (0.1165 <= 1.01 x 0.1160): the
+  // simpler ovoid; with none, the least RMS. Equal counts go by RMS.
+  EXPECT_EQ(pipeline::selectParsimonious(sphere_truth, 0.01).selected, "ovoid");
+  EXPECT_EQ(pipeline::selectParsimonious(sphere_truth, 0.0).selected, "superovoid");
+  EXPECT_EQ(pipeline::selectParsimonious({{"a", 4, 0.2}, {"b", 4, 0.19}}).selected, "b");
+  // Nothing finite: nothing selected.
+  EXPECT_EQ(pipeline::selectParsimonious({{"sphere", 4, NAN}}).selected, "");
+}
+
+}  // namespace
+}  // namespace articula

@@ -86,4 +86,22 @@ WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vecto
 double aic(double sse, int n, int k) { return n * std::log(sse / n) + 2.0 * k; }
 double bic(double sse, int n, int k) { return n * std::log(sse / n) + k * std::log(static_cast<double>(n)); }
 
+ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance) {
+  ModelSelection out;
+  double least = INFINITY;
+  for (const auto& s : scores)
+    if (std::isfinite(s.rms_mm)) least = std::min(least, s.rms_mm);
+  if (!std::isfinite(least)) return out;
+  const ModelScore* chosen = nullptr;
+  for (const auto& s : scores) {
+    if (!(s.rms_mm <= least * (1.0 + relative_tolerance))) continue;
+    out.indistinguishable.push_back(s.model);
+    if (!chosen || s.n_parameters < chosen->n_parameters ||
+        (s.n_parameters == chosen->n_parameters && s.rms_mm < chosen->rms_mm))
+      chosen = &s;
+  }
+  out.selected = chosen->model;
+  return out;
+}
+
 }  // namespace articula::pipeline

@@ -36,6 +36,7 @@ struct ModelRow {
   std::string subject, model;
   nlohmann::json entry;  // the model's entry of results.json
   bool best = false;
+  bool selected = false;  // results.json's selected_model
 };
 
 // study.svg: RMS per model, subject by subject (subjects in manifest order).
@@ -75,9 +76,9 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     } catch (const nlohmann::json::exception& e) {
       throw ProcessingError("cannot read '" + path.string() + "': " + e.what());
     }
-    const std::string best = results.value("best_model", "");
+    const std::string best = results.value("best_model", ""), selected = results.value("selected_model", "");
     for (const auto& m : results.at("models")) {
-      ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best};
+      ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best, m.at("model") == selected};
       for (const auto& [key, value] : m.at("parameters").items())
         if (std::find(parameter_columns.begin(), parameter_columns.end(), key) == parameter_columns.end())
           parameter_columns.push_back(key);
@@ -90,7 +91,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   // study.csv
   std::vector<std::string> header = {"subject", "model", "n_parameters"};
   header.insert(header.end(), kErrorColumns.begin(), kErrorColumns.end());
-  header.insert(header.end(), {"aic", "bic", "best_by_rms"});
+  header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected"});
   header.insert(header.end(), parameter_columns.begin(), parameter_columns.end());
   std::string study_csv = csvLine(header) + "\n";
   for (const auto& r : rows) {
@@ -99,6 +100,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     f.push_back(number(r.entry.value("aic", NAN)));
     f.push_back(number(r.entry.value("bic", NAN)));
     f.push_back(r.best ? "1" : "0");
+    f.push_back(r.selected ? "1" : "0");
     for (const auto& c : parameter_columns)
       f.push_back(r.entry.at("parameters").contains(c) ? number(r.entry.at("parameters").at(c).get<double>()) : "");
     study_csv += csvLine(f) + "\n";
@@ -107,20 +109,21 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   // Per subject, the model with the least AIC and BIC; per model, RMS by subject.
   std::map<std::string, std::map<std::string, const ModelRow*>> by_subject;
   for (const auto& r : rows) by_subject[r.subject][r.model] = &r;
-  std::map<std::string, int> best_rms, best_aic, best_bic;
+  std::map<std::string, int> best_rms, best_aic, best_bic, times_selected;
   for (const auto& [subject, models] : by_subject) {
     const ModelRow *a = nullptr, *b = nullptr;
     for (const auto& [name, row] : models) {
       if (!a || row->entry.value("aic", INFINITY) < a->entry.value("aic", INFINITY)) a = row;
       if (!b || row->entry.value("bic", INFINITY) < b->entry.value("bic", INFINITY)) b = row;
       if (row->best) ++best_rms[name];
+      if (row->selected) ++times_selected[name];
     }
     if (a) ++best_aic[a->model];
     if (b) ++best_bic[b->model];
   }
 
   nlohmann::json summary_json = nlohmann::json::array();
-  std::string summary_csv = csvLine({"model", "n_subjects", "rms_mean_mm", "rms_sd_mm", "times_best_by_rms",
+  std::string summary_csv = csvLine({"model", "n_subjects", "rms_mean_mm", "rms_sd_mm", "times_selected", "times_best_by_rms",
                                      "times_best_by_aic", "times_best_by_bic", "mean_delta_aic_vs_sphere",
                                      "mean_delta_bic_vs_sphere", "wilcoxon_n_vs_sphere", "wilcoxon_p_vs_sphere"}) +
                             "\n";
@@ -145,6 +148,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
                                         std::to_string(s.n),
                                         number(s.mean),
                                         number(s.sd),
+                                        std::to_string(times_selected[model]),
                                         std::to_string(best_rms[model]),
                                         std::to_string(best_aic[model]),
                                         std::to_string(best_bic[model]),
@@ -157,6 +161,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
                             {"n_subjects", s.n},
                             {"rms_mean_mm", s.mean},
                             {"rms_sd_mm", s.sd},
+                            {"times_selected", times_selected[model]},
                             {"times_best_by_rms", best_rms[model]},
                             {"times_best_by_aic", best_aic[model]},
                             {"times_best_by_bic", best_bic[model]}};

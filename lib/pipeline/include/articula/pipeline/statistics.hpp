@@ -2,6 +2,7 @@
 // Statistics of a morphology study: summaries of signed errors, the paired
 // Wilcoxon signed-rank test, and information criteria that weigh the number
 // of parameters beside the fit.
+#include <string>
 #include <vector>
 
 namespace articula::pipeline {
@@ -29,5 +30,24 @@ WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vecto
 /// BIC = n ln(sse/n) + k ln(n) (constants dropped: compare within one point set).
 double aic(double sse, int n, int k);
 double bic(double sse, int n, int k);
+
+/// Which model the data support. The least RMS always goes to the most
+/// flexible model, and AIC/BIC on a thousand points from a voxelised,
+/// meshed surface reward fitting its systematic (staircase, smoothing)
+/// deviations: on phantoms of known shape they pick the ovoid for a true
+/// sphere. So the selected model is the simplest (fewest parameters, then
+/// least RMS) whose RMS is within `relative_tolerance` of the least RMS;
+/// `indistinguishable` lists every model within it, i.e. the models these
+/// points cannot tell apart.
+struct ModelScore {
+  std::string model;
+  int n_parameters = 0;
+  double rms_mm = 0.0;
+};
+struct ModelSelection {
+  std::string selected;
+  std::vector<std::string> indistinguishable;  // in the order given
+};
+ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance = 0.10);
 
 }  // namespace articula::pipeline
