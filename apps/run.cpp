@@ -40,7 +40,8 @@ struct Forwarded {
   const char* stage;
 };
 const Forwarded kForwarded[] = {{"seed-point", "segment"},    {"series-uid", "segment"}, {"hu-min", "segment"},
-                                {"hu-max", "segment"},        {"roi", "segment"},        {"smoothing", "mesh"},
+                                {"hu-max", "segment"},        {"roi", "segment"},        {"level-set", "segment"},
+                                {"smoothing", "mesh"},
                                 {"smooth-iterations", "mesh"}, {"relaxation", "mesh"},   {"decimate", "mesh"},
                                 {"select", "sample"},         {"ball-radius", "sample"}, {"ratio", "sample"},
                                 {"models", "fit"},            {"objective", "fit"}};

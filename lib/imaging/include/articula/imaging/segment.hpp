@@ -3,7 +3,8 @@
 // HU threshold, optional ROI, closing and hole filling, automatic head
 // finding (a Hough transform for spheres on the chosen side, ~2 mm grid), then a marker
 // watershed on the distance to the bone surface, which cuts the head from
-// the socket and the neck at the narrow bone bridges between them.
+// the socket and the neck at the narrow bone bridges between them; the
+// head's surface at a HU level or, optionally, by a geodesic active contour.
 #include <optional>
 #include <string>
 #include <vector>
