@@ -121,7 +121,7 @@ Bounds makeBounds(ShapeModel model, const ShapeParameters& reference, const Shap
     } else if (n[0] == 'c') {
       lo = o.c23_min;
       hi = o.c23_max;
-    } else if (n[0] == 't') {
+    } else if (n == "t1" || n == "t2" || n == "t3") {  // not "theta"
       const int axis = n[1] - '1';
       lo = std::min(reference.center[axis], sphere.center[axis]) - o.center_interval * r_max;
       hi = std::max(reference.center[axis], sphere.center[axis]) + o.center_interval * r_max;
