@@ -138,12 +138,21 @@ void runMethod(benchmark::State& state, const Method& method) {
 }
 
 // ---------------------------------------------------------------- ours
-void BM_OursCold(benchmark::State& state) {
-  runMethod(state, [](const Pair& p) { return computeContact(p.a, p.b).distance; });
+// Also counts the mean Newton iterations and starts per query (where the time goes).
+void runOurs(benchmark::State& state, bool warm) {
+  runMethod(state, [warm](const Pair& p) { return computeContact(p.a, p.b, {}, warm ? &p.previous : nullptr).distance; });
+  double iterations = 0.0, starts = 0.0;
+  const auto& pairs = pairSet(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  for (const Pair& p : pairs) {
+    const ContactSummary s = computeContact(p.a, p.b, {}, warm ? &p.previous : nullptr).summary;
+    iterations += s.iterations;
+    starts += s.starts;
+  }
+  state.counters["mean_iterations"] = iterations / static_cast<double>(pairs.size());
+  state.counters["mean_starts"] = starts / static_cast<double>(pairs.size());
 }
-void BM_OursWarm(benchmark::State& state) {
-  runMethod(state, [](const Pair& p) { return computeContact(p.a, p.b, {}, &p.previous).distance; });
-}
+void BM_OursCold(benchmark::State& state) { runOurs(state, false); }
+void BM_OursWarm(benchmark::State& state) { runOurs(state, true); }
 
 // ---------------------------------------------------------------- Simbody
 SimTK::Transform simbodyTransform(const ConvexShape& s) {

@@ -359,8 +359,9 @@ struct Solver {
 
 ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const ContactOptions& options,
                              const ContactResult* warm_start) {
+  if (options.solver == ContactSolver::Auto && a.quadric && b.quadric)
+    return ellipsoidContact(a, b, options, warm_start);  // validates the options
   options.validate();
-  if (options.solver == ContactSolver::Auto && a.quadric && b.quadric) return ellipsoidContact(a, b, options, warm_start);
   ContactResult result;
   ContactSummary& summary = result.summary;
   bool hill_climb_answer = false;

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "articula/core/error.hpp"
-#include "articula/geometry/frames.hpp"
 
 namespace articula::contact {
 
@@ -15,34 +15,38 @@ using Eigen::Vector3d;
 
 namespace {
 
-constexpr int kNeighbours = 6;    // sample-graph neighbours for "local maximum"
-constexpr int kMaxAscents = 6;    // Newton ascents from samples, at most
+constexpr int kMaxAscents = 64;   // Newton ascents from samples, at most
 constexpr double kSame = 0.999;     // an ascent this close to a maximum reached goes there
 constexpr double kMoved = 0.98;     // a warm ascent that turned the normal further may have changed basin
-constexpr double kDistinct = 0.85;  // samples with v . w above this are not distinct starts
 constexpr double kGradientTolerance = 1e-11;  // |tangential grad s| / length
 
 // Antipodal directions (a Fibonacci lattice on the upper half, then its
-// negation), the products x^2, y^2, z^2, 2xy, 2xz, 2yz of each upper
-// direction (v'Mv is then one 6-term dot product and serves v and -v), each
-// direction's nearest neighbours and the directions within kDistinct of it,
-// and the covering radius of the set. Cached per count.
+// negation); the upper half's coordinates again as separate arrays, so that
+// the scan vectorises; and the covering radius rho of the set: every unit
+// vector lies within rho of a direction (the direction's cap). Cached per count.
 struct DirectionSet {
   int count = 0;
-  std::vector<Vector3d> directions;                     // count; [i + count/2] = -[i]
-  std::vector<std::array<double, 6>> monomials;         // count / 2
-  std::vector<std::array<int, kNeighbours>> neighbours;  // count
-  std::vector<std::vector<int>> near;                    // count
-  double cos_cover = 1.0, sin_cover = 0.0;              // covering radius rho
+  std::vector<Vector3d> directions;  // count; [i + count/2] = -[i]
+  std::vector<double> x, y, z;       // count / 2: the upper half
+  double rho = 0.0, cos_rho = 1.0, sin_rho = 0.0;
+  // A sample this close to a maximum reached (cos(2 rho)) is taken to lie in
+  // its basin and is not ascended from (the one assumption of the search).
+  double cos_settled = 1.0;
 };
 
 const DirectionSet& directionSet(int count) {
-  thread_local DirectionSet set;
+  thread_local std::map<int, DirectionSet> sets;  // per count: callers may alternate option sets
+  thread_local const DirectionSet* last = nullptr;
+  if (last && last->count == count) return *last;
+  DirectionSet& set = sets[count];
+  last = &set;
   if (set.count == count) return set;
   set.count = count;
   const int half = count / 2;
   set.directions.assign(static_cast<size_t>(2 * half), Vector3d::Zero());
-  set.monomials.clear();
+  set.x.resize(static_cast<size_t>(half));
+  set.y.resize(static_cast<size_t>(half));
+  set.z.resize(static_cast<size_t>(half));
   const double golden = M_PI * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < half; ++i) {
     const double z = 1.0 - (i + 0.5) / half;  // (0, 1): the upper half
@@ -50,19 +54,9 @@ const DirectionSet& directionSet(int count) {
     const Vector3d v(r * std::cos(golden * i), r * std::sin(golden * i), z);
     set.directions[static_cast<size_t>(i)] = v;
     set.directions[static_cast<size_t>(i + half)] = -v;
-    set.monomials.push_back({v.x() * v.x(), v.y() * v.y(), v.z() * v.z(), 2.0 * v.x() * v.y(), 2.0 * v.x() * v.z(),
-                             2.0 * v.y() * v.z()});
-  }
-  const int n = 2 * half;
-  set.neighbours.resize(static_cast<size_t>(n));
-  set.near.assign(static_cast<size_t>(n), {});
-  std::vector<std::pair<double, int>> order(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) order[static_cast<size_t>(j)] = {-set.directions[i].dot(set.directions[j]), j};
-    std::partial_sort(order.begin(), order.begin() + kNeighbours + 1, order.end());
-    for (int k = 0; k < kNeighbours; ++k) set.neighbours[static_cast<size_t>(i)][k] = order[k + 1].second;
-    for (int j = 0; j < n; ++j)
-      if (set.directions[i].dot(set.directions[j]) > kDistinct) set.near[static_cast<size_t>(i)].push_back(j);
+    set.x[static_cast<size_t>(i)] = v.x();
+    set.y[static_cast<size_t>(i)] = v.y();
+    set.z[static_cast<size_t>(i)] = v.z();
   }
   // Covering radius: the largest angle from a dense probe set to its nearest direction.
   double cos_cover = 1.0;
@@ -75,43 +69,114 @@ const DirectionSet& directionSet(int count) {
     cos_cover = std::min(cos_cover, nearest);
   }
   // Margin for the probe set's own spacing (about 0.06 rad at 4,000 probes).
-  const double rho = std::acos(cos_cover) + 0.06;
-  set.cos_cover = std::cos(rho);
-  set.sin_cover = std::sin(rho);
+  set.rho = std::acos(cos_cover) + 0.06;
+  set.cos_rho = std::cos(set.rho);
+  set.sin_rho = std::sin(set.rho);
+  set.cos_settled = std::cos(2.0 * set.rho);
   return set;
 }
 
-// The dual, its gradient g = x_B(-v) - x_A(v) and the pieces of its Hessian at a unit v.
+// A symmetric 3x3 matrix by its six entries: the hot loop's shape matrices
+// at half the arithmetic of a full Matrix3d product.
+struct Symmetric3 {
+  double xx = 0.0, yy = 0.0, zz = 0.0, xy = 0.0, xz = 0.0, yz = 0.0;
+  Vector3d operator*(const Vector3d& v) const {
+    return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
+            xz * v.x() + yz * v.y() + zz * v.z()};
+  }
+  // this + w x x^T
+  void addOuter(double w, const Vector3d& x) {
+    xx += w * x.x() * x.x(), yy += w * x.y() * x.y(), zz += w * x.z() * x.z();
+    xy += w * x.x() * x.y(), xz += w * x.x() * x.z(), yz += w * x.y() * x.z();
+  }
+  double determinant() const {
+    return xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+  }
+  // Solves this * x = r by the adjugate (this must be non-singular).
+  Vector3d solve(const Vector3d& r) const {
+    const double cxx = yy * zz - yz * yz, cyy = xx * zz - xz * xz, czz = xx * yy - xy * xy;
+    const double cxy = xz * yz - xy * zz, cxz = xy * yz - xz * yy, cyz = xy * xz - xx * yz;
+    const double inverse_det = 1.0 / (xx * cxx + xy * cxy + xz * cxz);
+    return inverse_det * Vector3d(cxx * r.x() + cxy * r.y() + cxz * r.z(), cxy * r.x() + cyy * r.y() + cyz * r.z(),
+                                  cxz * r.x() + cyz * r.y() + czz * r.z());
+  }
+};
+
+// L = D R^T: the support function is h(v) = |L v|.
+Matrix3d supportMatrix(const ConvexShape& shape) { return shape.radii.asDiagonal() * shape.rotation.transpose(); }
+
+// M = R D^2 R^T = L^T L, the matrix of the support function h(v) = sqrt(v' M v).
+Symmetric3 shapeMatrix(const ConvexShape& shape) {
+  Symmetric3 m;
+  for (int k = 0; k < 3; ++k) m.addOuter(shape.radii[k] * shape.radii[k], shape.rotation.col(k));
+  return m;
+}
+
+// The dual at a unit v: s, its gradient g = x_B(-v) - x_A(v) in R^3, the
+// support offsets x_A(v) - c_A = M_A v / h_A and c_B - x_B(-v) = M_B v / h_B.
 struct DualPoint {
-  Vector3d v, mav, mbv, g;
+  Vector3d v, xa, xb, g;
   double ha, hb, s;
 };
 
+// An upper bound of s on the cap of radius rho around a unit w, from
+// s = s(w), g2 = |grad s(w)|^2 and k <= the support functions' curvature on
+// the cap. Along a great circle from w, s'' = -s - k_A - k_B <= -s - k, so
+// s(phi) <= (s + k) cos phi + G sin phi - k (Sturm comparison; G, the
+// tangential gradient, bounds s'(0)), at most |g'| cos(max(0, theta' - rho)) - k
+// for the shifted s + k = |g'| cos theta'. (k = 0 gives the concavity
+// bound s(v) <= grad s(w) . v. Both sides of the select are computed: the scan vectorises.)
+inline double capBound(double s, double g2, double k, double cos_rho, double sin_rho) {
+  const double excess = g2 - s * s, shifted = s + k, tangential2 = excess > 0.0 ? excess : 0.0;
+  const double r = std::sqrt(shifted * shifted + tangential2);
+  const double tilted = shifted * cos_rho + std::sqrt(tangential2) * sin_rho;
+  return (shifted >= r * cos_rho ? r : tilted) - k;
+}
+
 struct Dual {
-  Matrix3d ma, mb;
-  std::array<double, 6> ma6, mb6;  // xx, yy, zz, xy, xz, yz
+  Symmetric3 ma, mb;
   Vector3d c;
   double length;
+  // (r_min r_mid)^2 and r_max of each: the support function's curvature is at least the first over |L v|^3.
+  double curvature_a, max_radius_a, curvature_b, max_radius_b;
   double gradient_tolerance;
 
-  Dual(const ConvexShape& a, const ConvexShape& b) {
-    ma = a.rotation * a.radii.cwiseAbs2().asDiagonal() * a.rotation.transpose();
-    mb = b.rotation * b.radii.cwiseAbs2().asDiagonal() * b.rotation.transpose();
-    ma6 = {ma(0, 0), ma(1, 1), ma(2, 2), ma(0, 1), ma(0, 2), ma(1, 2)};
-    mb6 = {mb(0, 0), mb(1, 1), mb(2, 2), mb(0, 1), mb(0, 2), mb(1, 2)};
-    c = b.center - a.center;
+  Dual(const ConvexShape& a, const ConvexShape& b)
+      : ma(shapeMatrix(a)), mb(shapeMatrix(b)), c(b.center - a.center) {
     length = std::max(a.radii.maxCoeff(), b.radii.maxCoeff());
+    max_radius_a = a.radii.maxCoeff();
+    max_radius_b = b.radii.maxCoeff();
+    curvature_a = std::pow(a.radii.prod() / max_radius_a, 2);
+    curvature_b = std::pow(b.radii.prod() / max_radius_b, 2);
     gradient_tolerance = kGradientTolerance * length;
+  }
+
+  // A lower bound of the curvature k_A + k_B of the support functions on the
+  // cap of radius rho around a unit w with h_A(w) = ha, h_B(w) = hb:
+  // k_A = |L e x L v|^2 / |L v|^3 >= (r_min r_mid)^2 / |L v|^3 (L = D R^T,
+  // e a unit tangent; |L e x L v| = det L |L^-T (e x v)|), and on the cap
+  // |L v| <= min(r_max, h_A(w) + rho r_max). (Ternaries, not std::min: the scan vectorises.)
+  double curvatureBound(double ha, double hb, double rho) const {
+    const double la_cap = ha + rho * max_radius_a, lb_cap = hb + rho * max_radius_b;
+    const double la = la_cap < max_radius_a ? la_cap : max_radius_a, lb = lb_cap < max_radius_b ? lb_cap : max_radius_b;
+    return curvature_a / (la * la * la) + curvature_b / (lb * lb * lb);
+  }
+
+  // capBound on the cap of `set` around p.v.
+  double capBound(const DualPoint& p, const DirectionSet& set) const {
+    return articula::contact::capBound(p.s, p.g.squaredNorm(), curvatureBound(p.ha, p.hb, set.rho), set.cos_rho,
+                                       set.sin_rho);
   }
 
   DualPoint eval(const Vector3d& v) const {
     DualPoint p;
     p.v = v;
-    p.mav.noalias() = ma * v;
-    p.mbv.noalias() = mb * v;
-    p.ha = std::sqrt(v.dot(p.mav));
-    p.hb = std::sqrt(v.dot(p.mbv));
-    p.g = c - p.mav / p.ha - p.mbv / p.hb;
+    const Vector3d mav = ma * v, mbv = mb * v;
+    p.ha = std::sqrt(v.dot(mav));
+    p.hb = std::sqrt(v.dot(mbv));
+    p.xa = mav / p.ha;
+    p.xb = mbv / p.hb;
+    p.g = c - p.xa - p.xb;
     p.s = v.dot(c) - p.ha - p.hb;
     return p;
   }
@@ -119,36 +184,43 @@ struct Dual {
   // Newton step on the sphere at p: the tangent step (capped at 0.5 rad),
   // the squared tangential gradient, and the model's gain r . d / 2 when the
   // Hessian is negative definite (NaN when it had to be shifted).
+  //
+  // s is 1-homogeneous, so its Hessian in R^3,
+  //   H = -(M_A - x_A x_A') / h_A - (M_B - x_B x_B') / h_B,
+  // has H v = 0, and the Riemannian Hessian on the tangent plane is H - s I.
+  // The 3x3 matrix K = H - s I + (s - L) v v' equals it there and has v as
+  // an eigenvector (eigenvalue -L), so K d = -r with r tangent gives the
+  // tangent Newton step directly, without a tangent frame; the tangent
+  // block's trace and determinant are tr K + L and -det K / L.
   struct Step {
     Vector3d d;
     double gradient2, gain;
   };
   Step newtonStep(const DualPoint& p) const {
-    const geometry::TangentFrame f = geometry::householderFrameUnit(p.v);
-    const double r1 = f.t.dot(p.g), r2 = f.b.dot(p.g);
-    // Tangential Hessian of s: -(M_A - M_A v v'M_A / h_A^2) / h_A - (same for B) - s I.
-    const Vector3d mat = ma * f.t, mab = ma * f.b, mbt = mb * f.t, mbb = mb * f.b;
-    const double ta = f.t.dot(p.mav) / p.ha, ba = f.b.dot(p.mav) / p.ha;
-    const double tb = f.t.dot(p.mbv) / p.hb, bb = f.b.dot(p.mbv) / p.hb;
-    double h11 = -(f.t.dot(mat) - ta * ta) / p.ha - (f.t.dot(mbt) - tb * tb) / p.hb - p.s;
-    double h12 = -(f.t.dot(mab) - ta * ba) / p.ha - (f.t.dot(mbb) - tb * bb) / p.hb;
-    double h22 = -(f.b.dot(mab) - ba * ba) / p.ha - (f.b.dot(mbb) - bb * bb) / p.hb - p.s;
-    // Where the sphere makes it indefinite (overlap, s < 0) or nearly
-    // singular, shift it to negative definite (a trust-region-like step).
-    const double mean = 0.5 * (h11 + h22), dev = std::sqrt(0.25 * (h11 - h22) * (h11 - h22) + h12 * h12);
+    const Vector3d r = p.g - p.g.dot(p.v) * p.v;
+    const double ia = 1.0 / p.ha, ib = 1.0 / p.hb;
+    Symmetric3 k{-(ma.xx * ia + mb.xx * ib) - p.s, -(ma.yy * ia + mb.yy * ib) - p.s, -(ma.zz * ia + mb.zz * ib) - p.s,
+                 -(ma.xy * ia + mb.xy * ib),       -(ma.xz * ia + mb.xz * ib),       -(ma.yz * ia + mb.yz * ib)};
+    k.addOuter(ia, p.xa);
+    k.addOuter(ib, p.xb);
+    k.addOuter(p.s - length, p.v);
+    // Where the sphere makes the tangent block indefinite (overlap, s < 0)
+    // or nearly singular, shift it to negative definite (a trust-region-like step).
+    const double mean = 0.5 * (k.xx + k.yy + k.zz + length), det = -k.determinant() / length;
+    const double dev = std::sqrt(std::max(0.0, mean * mean - det));
     const double top = mean + dev, bottom = mean - dev;
     const bool definite = top < -1e-6 * std::max(std::fabs(bottom), length);
     if (!definite) {
       const double shift = top + std::max({top, 0.1 * std::fabs(bottom), 1e-3 * length});
-      h11 -= shift;
-      h22 -= shift;
+      k.xx -= shift, k.yy -= shift, k.zz -= shift;
+      k.addOuter(shift, p.v);
     }
-    const double det = h11 * h22 - h12 * h12;
-    double d1 = -(h22 * r1 - h12 * r2) / det, d2 = -(h11 * r2 - h12 * r1) / det;
-    const double gain = definite ? 0.5 * (r1 * d1 + r2 * d2) : NAN;
-    const double norm = std::sqrt(d1 * d1 + d2 * d2);
-    if (norm > 0.5) d1 *= 0.5 / norm, d2 *= 0.5 / norm;  // at most about 0.5 rad at once
-    return {d1 * f.t + d2 * f.b, r1 * r1 + r2 * r2, gain};
+    Vector3d d = -k.solve(r);
+    d -= d.dot(p.v) * p.v;  // tangent to rounding
+    const double gain = definite ? 0.5 * r.dot(d) : NAN;
+    const double norm = d.norm();
+    if (norm > 0.5) d *= 0.5 / norm;  // at most about 0.5 rad at once
+    return {d, r.squaredNorm(), gain};
   }
 
   double gradient2(const DualPoint& p) const { return (p.g - p.g.dot(p.v) * p.v).squaredNorm(); }
@@ -158,18 +230,27 @@ struct Dual {
   // line search stops it). With `found` (maxima already reached, the best
   // value `beat`), gives up early, unconverged, once the iterate is heading
   // for one of them or the Newton model puts this maximum well below `beat`.
-  DualPoint ascend(DualPoint p, int max_iterations, int& iterations, bool& converged,
+  //
+  // `ceiling`: what the ascent could still reach from where it stopped: s at
+  // a maximum, the Newton model's s + 4 gain when it gave up on that, -inf
+  // when it was heading for a maximum already reached, +inf otherwise.
+  DualPoint ascend(DualPoint p, int max_iterations, int& iterations, bool& converged, double& ceiling,
                    const std::vector<Vector3d>* found = nullptr, double beat = 0.0) const {
     converged = false;
+    ceiling = INFINITY;
     const double tolerance2 = gradient_tolerance * gradient_tolerance;
     for (int it = 0; it < max_iterations; ++it) {
       if (gradient2(p) <= tolerance2) {
         converged = true;
+        ceiling = p.s;
         return p;
       }
       ++iterations;
       const Step step = newtonStep(p);
-      if (found && p.s + 4.0 * step.gain < beat) return p;  // false when the gain is NaN
+      if (found && p.s + 4.0 * step.gain < beat) {  // false when the gain is NaN
+        ceiling = p.s + 4.0 * step.gain;
+        return p;
+      }
       bool accepted = false;
       const double rounding = 1e-15 * (std::fabs(p.s) + p.ha + p.hb);
       for (double alpha = 1.0; alpha >= 1.0 / 64.0; alpha *= 0.5) {
@@ -180,17 +261,51 @@ struct Dual {
           break;
         }
       }
-      if (found && std::any_of(found->begin(), found->end(), [&](const Vector3d& f) { return f.dot(p.v) > kSame; }))
+      if (found && std::any_of(found->begin(), found->end(), [&](const Vector3d& f) { return f.dot(p.v) > kSame; })) {
+        ceiling = -INFINITY;
         return p;
+      }
       if (!accepted) {
         // No ascent possible: a maximum to rounding when the gradient is tiny.
         converged = step.gradient2 <= 1e6 * tolerance2;
+        if (converged) ceiling = p.s;
         return p;
       }
     }
     return p;
   }
 };
+
+// s at every direction of the set and an upper bound of s on its cap:
+// s_out[i], bound_out[i] for v_i, [i + count/2] for -v_i.
+// With x_A = M_A v / h_A and x_B = M_B v / h_B, g(v) = c - x_A - x_B and
+// g(-v) = c + x_A + x_B. (Separate arrays and __restrict: the loop vectorises.)
+void boundDual(const DirectionSet& set, const Dual& dual, double* __restrict s_out, double* __restrict bound_out) {
+  const int half = set.count / 2;
+  const double* __restrict x = set.x.data();
+  const double* __restrict y = set.y.data();
+  const double* __restrict z = set.z.data();
+  const double a0 = dual.ma.xx, a1 = dual.ma.yy, a2 = dual.ma.zz, a3 = dual.ma.xy, a4 = dual.ma.xz, a5 = dual.ma.yz;
+  const double b0 = dual.mb.xx, b1 = dual.mb.yy, b2 = dual.mb.zz, b3 = dual.mb.xy, b4 = dual.mb.xz, b5 = dual.mb.yz;
+  const double cx = dual.c.x(), cy = dual.c.y(), cz = dual.c.z();
+  const double rho = set.rho, cos_rho = set.cos_rho, sin_rho = set.sin_rho;
+  for (int i = 0; i < half; ++i) {
+    const double vx = x[i], vy = y[i], vz = z[i];
+    const double ax = a0 * vx + a3 * vy + a4 * vz, ay = a3 * vx + a1 * vy + a5 * vz, az = a4 * vx + a5 * vy + a2 * vz;  // M_A v
+    const double bx = b0 * vx + b3 * vy + b4 * vz, by = b3 * vx + b1 * vy + b5 * vz, bz = b4 * vx + b5 * vy + b2 * vz;  // M_B v
+    const double ha = std::sqrt(vx * ax + vy * ay + vz * az), hb = std::sqrt(vx * bx + vy * by + vz * bz);
+    const double ia = 1.0 / ha, ib = 1.0 / hb;
+    const double sx = ax * ia + bx * ib, sy = ay * ia + by * ib, sz = az * ia + bz * ib;  // x_A + x_B
+    const double vc = cx * vx + cy * vy + cz * vz, h = ha + hb;
+    const double up = vc - h, down = -vc - h;
+    const double gux = cx - sx, guy = cy - sy, guz = cz - sz, gdx = cx + sx, gdy = cy + sy, gdz = cz + sz;
+    const double k = dual.curvatureBound(ha, hb, rho);
+    s_out[i] = up;
+    s_out[i + half] = down;
+    bound_out[i] = capBound(up, gux * gux + guy * guy + guz * guz, k, cos_rho, sin_rho);
+    bound_out[i + half] = capBound(down, gdx * gdx + gdy * gdy + gdz * gdz, k, cos_rho, sin_rho);
+  }
+}
 
 }  // namespace
 
@@ -206,13 +321,15 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
   bool have = false, converged = false;
   // Ascends from `start`; keeps the best converged maximum; returns where it ended (nullptr: did not converge).
   DualPoint last;
-  thread_local std::vector<std::pair<double, Vector3d>> ends;  // where ascents ended: rivals of the answer
+  thread_local std::vector<std::pair<double, Vector3d>> ends;  // ceiling and end of each ascent: rivals of the answer
   ends.clear();
   auto consider = [&](const DualPoint& start, const std::vector<Vector3d>* found = nullptr) -> const DualPoint* {
     ++summary.starts;
     bool ok = false;
-    last = dual.ascend(start, options.max_iterations, summary.iterations, ok, converged ? found : nullptr, best.s);
-    ends.push_back({last.s, last.v});
+    double ceiling = INFINITY;
+    last = dual.ascend(start, options.max_iterations, summary.iterations, ok, ceiling, converged ? found : nullptr,
+                       best.s);
+    ends.push_back({ceiling, last.v});
     if ((ok && (!converged || last.s > best.s)) || !have) {
       best = last;
       have = true;
@@ -228,18 +345,26 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (std::isfinite(len) && len > 0.0) consider(dual.eval(warm_normal));
     if (have && converged && best.s > 0.0) {
       summary.termination = "warm start, separated (dual certificate)";
-    } else if (have && converged && warm_start->rival_count >= 0 && best.v.dot(warm_normal) > kMoved) {
-      // Overlap: still the global maximum unless a rival of the previous step,
-      // one Newton step on, is predicted to come near it.
-      bool safe = true;
-      result.rival_count = warm_start->rival_count;
-      for (int k = 0; k < warm_start->rival_count && safe; ++k) {
-        const DualPoint r = dual.eval(warm_start->rivals[k]);
-        const Dual::Step step = dual.newtonStep(r);
-        safe = r.s + 4.0 * step.gain < best.s;  // false when the Hessian is not definite
-        result.rivals[k] = (r.v + step.d).normalized();
+    } else if (have && converged && warm_start->search.rival_count >= 0 && best.v.dot(warm_normal) > kMoved) {
+      // Overlap: the answer stands while what the last global search saw
+      // stays below it: the dual has moved by at most `drift` since, so a
+      // bound from then, plus drift, still holds. Where that is not enough,
+      // a watched cap is bounded again here and a rival's Newton model is
+      // asked again here; if either could beat the answer, search again.
+      const DualSearchState& previous = warm_start->search;
+      result.search = previous;
+      const double drift = (dual.c - previous.offset).norm() + (supportMatrix(a) - previous.l_a).norm() +
+                           (supportMatrix(b) - previous.l_b).norm();
+      bool safe = previous.outside_bound + drift < best.s;
+      for (int k = 0; k < previous.watch_count && safe; ++k)
+        if (!(previous.watch_bounds[k] + drift < best.s))
+          safe = dual.capBound(dual.eval(previous.watch[k]), directionSet(previous.sample_directions)) < best.s;
+      for (int k = 0; k < previous.rival_count && safe; ++k) {
+        if (previous.rival_ceilings[k] + drift < best.s) continue;
+        const DualPoint r = dual.eval(previous.rivals[k]);
+        safe = r.s + 4.0 * dual.newtonStep(r).gain < best.s;  // false when the Hessian is not definite
       }
-      if (safe) summary.termination = "warm start, overlap (the previous step's rivals stay below)";
+      if (safe) summary.termination = "warm start, overlap (the last search's bounds, moved since, stay below)";
     }
   } else {
     const double len = dual.c.norm();
@@ -252,94 +377,106 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
   }
 
   if (!summary.termination) {
-    // Overlap, or close to it: sample the dual; ascend from the samples that
-    // are local maxima among their neighbours and from the best
-    // `global_starts` mutually distant samples (a narrow basin can fall
-    // between samples and hold no sampled maximum), best first, skipping a
-    // sample when a maximum already reached lies in its cap or when its cap
-    // bound s(v) <= g . v <= |g| cos(max(0, theta - rho)) cannot beat the best.
+    // Overlap, or close to it: sample the dual, bound it on every sample's
+    // cap (capBound), and ascend from the best sample; then, while some cap's
+    // bound beats the best maximum found, ascend from the sample with the
+    // highest bound. Samples within 2 rho of a maximum reached are taken to
+    // lie in its basin; every other cap ends up bounded below the answer.
     summary.global_search = true;
     const DirectionSet& set = directionSet(options.sample_directions);
-    const int half = set.count / 2, n = 2 * half;
-    thread_local std::vector<double> s;
+    const int n = set.count;
+    thread_local std::vector<double> s, initial, bound;  // bound: -inf once settled
     s.resize(static_cast<size_t>(n));
-    for (int i = 0; i < half; ++i) {
-      const auto& m = set.monomials[static_cast<size_t>(i)];
-      double qa = 0.0, qb = 0.0;
-      for (int k = 0; k < 6; ++k) qa += dual.ma6[k] * m[k], qb += dual.mb6[k] * m[k];
-      const double h = std::sqrt(qa) + std::sqrt(qb), vc = dual.c.dot(set.directions[static_cast<size_t>(i)]);
-      s[static_cast<size_t>(i)] = vc - h;
-      s[static_cast<size_t>(i + half)] = -vc - h;
-    }
-    // (Branch-free scans: with unpredictable comparisons, branches made these
-    // loops a third of a cold overlap query, perf.)
-    thread_local std::vector<std::pair<double, int>> candidates;
-    thread_local std::vector<double> masked;  // s, with -inf where a chosen start excludes a sample
-    candidates.clear();
-    masked.assign(s.begin(), s.end());
-    for (int k = 0; k < options.global_starts; ++k) {
-      int top = 0;
-      double top_value = masked[0];
-      for (int i = 1; i < n; ++i) {
-        const double value = masked[static_cast<size_t>(i)];
+    initial.resize(static_cast<size_t>(n));
+    boundDual(set, dual, s.data(), initial.data());
+    bound = initial;
+    thread_local std::vector<Vector3d> found;  // maxima reached so far
+    thread_local std::vector<int> ascended;  // samples ascended from
+    found.clear();
+    ascended.clear();
+    auto settle = [&](const DualPoint& maximum) {
+      found.push_back(maximum.v);
+      for (int i = 0; i < n; ++i)
+        if (set.directions[static_cast<size_t>(i)].dot(maximum.v) >= set.cos_settled) bound[static_cast<size_t>(i)] = -INFINITY;
+    };
+    if (converged) settle(best);
+    const double margin = 1e-12 * dual.length;
+    bool open = true;  // the ascent limit stopped the search before every cap was below the answer
+    for (int ascents = 0; ascents < kMaxAscents; ++ascents) {
+      // (Branch-free scan: unpredictable comparisons made a branchy scan slow, perf.)
+      const double* order = found.empty() ? s.data() : bound.data();
+      int top = -1;
+      double top_value = converged ? best.s + margin : -INFINITY;
+      for (int i = 0; i < n; ++i) {
+        const double value = bound[static_cast<size_t>(i)] == -INFINITY ? -INFINITY : order[i];
         const bool better = value > top_value;
         top = better ? i : top;
         top_value = better ? value : top_value;
       }
-      if (top_value == -INFINITY) break;
-      for (int j : set.near[static_cast<size_t>(top)]) masked[static_cast<size_t>(j)] = -INFINITY;
-      candidates.push_back({s[static_cast<size_t>(top)], top});
-    }
-    const size_t distinct = candidates.size();
-    for (int i = 0; i < n; ++i) {
-      const double si = s[static_cast<size_t>(i)];
-      const auto& nb = set.neighbours[static_cast<size_t>(i)];
-      bool local_max = true;
-      for (int k = 0; k < kNeighbours; ++k) local_max &= si >= s[static_cast<size_t>(nb[k])];
-      if (local_max && std::none_of(candidates.begin(), candidates.begin() + static_cast<long>(distinct),
-                                    [&](const auto& c) { return c.second == i; }))
-        candidates.push_back({si, i});
-    }
-    std::sort(candidates.begin(), candidates.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
-    thread_local std::vector<Vector3d> found;  // maxima reached so far
-    found.clear();
-    if (converged) found.push_back(best.v);
-    int ascents = 0;
-    for (const auto& [si, i] : candidates) {
-      const Vector3d& w = set.directions[static_cast<size_t>(i)];
-      if (std::any_of(found.begin(), found.end(), [&](const Vector3d& f) { return f.dot(w) >= set.cos_cover; }))
-        continue;  // a maximum already reached lies in its cap
-      const DualPoint p = dual.eval(w);
-      if (converged) {
-        const double gn = p.g.norm(), cos_t = gn > 0.0 ? p.s / gn : 1.0;
-        const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
-        const double cap_bound = cos_t >= set.cos_cover ? gn : gn * (cos_t * set.cos_cover + sin_t * set.sin_cover);
-        if (cap_bound <= best.s) continue;
+      if (top < 0) {
+        open = false;
+        break;
       }
-      if (ascents++ >= kMaxAscents) break;
-      if (const DualPoint* end = consider(p, &found)) found.push_back(end->v);
+      bound[static_cast<size_t>(top)] = -INFINITY;
+      ascended.push_back(top);
+      if (const DualPoint* end = consider(dual.eval(set.directions[static_cast<size_t>(top)]), &found)) settle(*end);
     }
-    // The best other ends are the rivals a warm start of the next step follows.
+    // For warm starts: where the other ascents ended (maxima, or where an
+    // ascent gave up) are the rivals the next step follows; the caps of the
+    // samples no ascent started from and no maximum settled (all bounded
+    // below the answer) are summed up by their highest bounds, the first few
+    // watched one by one and the rest by one bound.
+    DualSearchState& state = result.search;
     std::sort(ends.begin(), ends.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
-    result.rival_count = 0;
-    for (const auto& [value, v] : ends) {
-      if (result.rival_count == 2) break;
-      if (v.dot(best.v) > kSame ||
-          std::any_of(result.rivals, result.rivals + result.rival_count, [&](const Vector3d& r) { return r.dot(v) > kSame; }))
+    state.rival_count = 0;
+    bool untracked = false;  // more rivals than a warm start follows: it searches again
+    for (const auto& [ceiling, v] : ends) {
+      if (ceiling == -INFINITY || v.dot(best.v) > kSame ||
+          std::any_of(state.rivals, state.rivals + state.rival_count, [&](const Vector3d& r) { return r.dot(v) > kSame; }))
         continue;
-      result.rivals[result.rival_count++] = v;
+      if (state.rival_count == DualSearchState::kRivals) {
+        untracked = true;
+        break;
+      }
+      state.rival_ceilings[state.rival_count] = ceiling;
+      state.rivals[state.rival_count++] = v;
     }
+    constexpr int kKept = DualSearchState::kWatched + 1;
+    std::pair<double, int> highest[kKept];
+    std::fill(highest, highest + kKept, std::make_pair(-INFINITY, -1));
+    for (int i = 0; i < n; ++i) {
+      const Vector3d& w = set.directions[static_cast<size_t>(i)];
+      if (std::find(ascended.begin(), ascended.end(), i) != ascended.end() ||
+          std::any_of(found.begin(), found.end(), [&](const Vector3d& f) { return f.dot(w) >= set.cos_settled; }))
+        continue;
+      const double value = initial[static_cast<size_t>(i)];
+      int k = kKept;
+      for (; k > 0 && highest[k - 1].first < value; --k)
+        if (k < kKept) highest[k] = highest[k - 1];
+      if (k < kKept) highest[k] = {value, i};
+    }
+    state.watch_count = 0;
+    for (int k = 0; k < DualSearchState::kWatched && highest[k].second >= 0; ++k) {
+      state.watch_bounds[state.watch_count] = highest[k].first;
+      state.watch[state.watch_count++] = set.directions[static_cast<size_t>(highest[k].second)];
+    }
+    state.outside_bound = untracked ? INFINITY : highest[kKept - 1].first;
+    state.sample_directions = set.count;
+    state.l_a = supportMatrix(a);
+    state.l_b = supportMatrix(b);
+    state.offset = dual.c;
     summary.termination = !converged        ? "no ascent converged; best point of the dual reported"
                           : best.s > 0.0    ? "separated (dual certificate, after sampling)"
-                                            : "overlap: best sampled maximum";
+                          : open            ? "overlap: best maximum; the ascent limit left caps unresolved"
+                                            : "overlap: no sample's cap bound beats the best maximum";
   }
   summary.status = converged ? ContactStatus::Converged : ContactStatus::NotConverged;
 
   const Vector3d& v = best.v;
   result.normal = v;
   result.distance = best.s;
-  result.point_a = a.center + best.mav / best.ha;
-  result.point_b = b.center - best.mbv / best.hb;
+  result.point_a = a.center + best.xa;
+  result.point_b = b.center - best.xb;
   result.canonical_a = a.radii.cwiseProduct(a.rotation.transpose() * v) / best.ha;
   result.canonical_b = -b.radii.cwiseProduct(b.rotation.transpose() * v) / best.hb;
   summary.certified = converged && best.s > 0.0;

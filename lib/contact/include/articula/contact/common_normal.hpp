@@ -21,6 +21,7 @@
 // on a singular Jacobian or a rejected step it takes Levenberg-Marquardt
 // steps; when every start stalls, a hill climb on the dual gives the start.
 // Signed distance (table 5.2): d = sign(n_A . d_AB) |d_AB|, > 0 apart, < 0 overlap.
+#include <cmath>
 #include <string>
 
 #include <Eigen/Core>
@@ -68,6 +69,29 @@ struct ContactSummary {
   std::string briefReport() const;
 };
 
+/// What the global search of the support-function dual (overlapping
+/// ellipsoids, ellipsoid_contact.hpp) leaves for warm starts, so that they
+/// keep the answer without searching again while they can prove it: where
+/// the other ascents ended (rivals) with the most they could still reach,
+/// the sample caps whose bounds came closest to the answer (watched) with
+/// those bounds, and one bound of the dual everywhere else; all at the
+/// search's pose (L = D R^T of each shape, c_B - c_A). The dual has moved by
+/// at most |delta c| + |delta L_A|_F + |delta L_B|_F since.
+struct DualSearchState {
+  static constexpr int kRivals = 3, kWatched = 4;
+  int rival_count = -1;  // -1: no global search behind this result
+  Eigen::Vector3d rivals[kRivals] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  double rival_ceilings[kRivals] = {INFINITY, INFINITY, INFINITY};
+  int watch_count = 0;
+  Eigen::Vector3d watch[kWatched] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                     Eigen::Vector3d::Zero()};
+  double watch_bounds[kWatched] = {INFINITY, INFINITY, INFINITY, INFINITY};
+  int sample_directions = 0;        // of the search (the caps' radius)
+  double outside_bound = INFINITY;  // s beyond the answer, the rivals and the watched caps
+  Eigen::Matrix3d l_a = Eigen::Matrix3d::Zero(), l_b = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+};
+
 struct ContactResult {
   double distance = 0.0;                                    // signed, mm
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero();        // on A (mm)
@@ -75,12 +99,7 @@ struct ContactResult {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();        // unit outward normal of A at point_a
   Eigen::Vector3d canonical_a = Eigen::Vector3d::UnitX();   // u_A: warm start of the next call
   Eigen::Vector3d canonical_b = -Eigen::Vector3d::UnitX();  // u_B
-  // Overlapping ellipsoids: normals (unit, global) at other local maxima of
-  // the dual that the global search reached, best first. A warm start
-  // follows them with one Newton step each to notice when one overtakes the
-  // answer; rival_count -1: no global search behind this result.
-  int rival_count = -1;
-  Eigen::Vector3d rivals[2] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX()};
+  DualSearchState search;  // ellipsoid pairs: for warm starts (ellipsoid_contact.hpp)
   ContactSummary summary;
 };
 
