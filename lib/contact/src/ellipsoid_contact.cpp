@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "articula/core/error.hpp"
+#include "articula/geometry/frames.hpp"
 
 namespace articula::contact {
 
@@ -19,6 +20,7 @@ constexpr int kMaxAscents = 64;   // Newton ascents from samples, at most
 constexpr double kSame = 0.999;     // an ascent this close to a maximum reached goes there
 constexpr double kMoved = 0.98;     // a warm ascent that turned the normal further may have changed basin
 constexpr double kGradientTolerance = 1e-11;  // |tangential grad s| / length
+constexpr int kRefinements = 2;  // a warm start splits a watched cap this often before searching again
 
 // Antipodal directions (a Fibonacci lattice on the upper half, then its
 // negation); the upper half's coordinates again as separate arrays, so that
@@ -163,9 +165,28 @@ struct Dual {
   }
 
   // capBound on the cap of `set` around p.v.
-  double capBound(const DualPoint& p, const DirectionSet& set) const {
-    return articula::contact::capBound(p.s, p.g.squaredNorm(), curvatureBound(p.ha, p.hb, set.rho), set.cos_rho,
-                                       set.sin_rho);
+  double capBound(const DualPoint& p, double rho) const {
+    return articula::contact::capBound(p.s, p.g.squaredNorm(), curvatureBound(p.ha, p.hb, rho), std::cos(rho),
+                                       std::sin(rho));
+  }
+
+  // Whether s stays below `beat` on the cap of radius rho around w: by its
+  // bound, else (depth > 0) by covering the cap with 7 caps of radius
+  // 0.55 rho, one at w and six around it at 0.866 rho, and asking each (in
+  // the plane, radius rho / 2 just covers; 0.55 leaves room for the sphere's
+  // curvature at rho <= 0.5).
+  bool capBelow(const Vector3d& w, double rho, double beat, int depth) const {
+    if (capBound(eval(w), rho) < beat) return true;
+    if (depth == 0) return false;
+    const double small = 0.55 * rho, ring = 0.866 * rho;
+    const geometry::TangentFrame f = geometry::householderFrameUnit(w);
+    if (!capBelow(w, small, beat, depth - 1)) return false;
+    for (int k = 0; k < 6; ++k) {
+      const double angle = k * M_PI / 3.0;
+      const Vector3d t = std::cos(angle) * f.t + std::sin(angle) * f.b;
+      if (!capBelow(std::cos(ring) * w + std::sin(ring) * t, small, beat, depth - 1)) return false;
+    }
+    return true;
   }
 
   DualPoint eval(const Vector3d& v) const {
@@ -307,6 +328,33 @@ void boundDual(const DirectionSet& set, const Dual& dual, double* __restrict s_o
   }
 }
 
+// Marks the samples within 2 rho of a maximum reached (bound -inf).
+void settleSamples(const DirectionSet& set, const Vector3d& maximum, double* __restrict bound) {
+  const int half = set.count / 2;
+  const double* __restrict x = set.x.data();
+  const double* __restrict y = set.y.data();
+  const double* __restrict z = set.z.data();
+  const double mx = maximum.x(), my = maximum.y(), mz = maximum.z(), limit = set.cos_settled;
+  for (int i = 0; i < half; ++i) {
+    const double d = x[i] * mx + y[i] * my + z[i] * mz;
+    bound[i] = d >= limit ? -INFINITY : bound[i];
+    bound[i + half] = -d >= limit ? -INFINITY : bound[i + half];
+  }
+}
+
+// The index of the largest value above `floor`, or -1. (Branch-free: with
+// unpredictable comparisons, branches made such scans slow, perf.)
+int highestAbove(const double* values, int n, double floor) {
+  int top = -1;
+  double top_value = floor;
+  for (int i = 0; i < n; ++i) {
+    const bool better = values[i] > top_value;
+    top = better ? i : top;
+    top_value = better ? values[i] : top_value;
+  }
+  return top;
+}
+
 }  // namespace
 
 ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const ContactOptions& options,
@@ -356,9 +404,10 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
       const double drift = (dual.c - previous.offset).norm() + (supportMatrix(a) - previous.l_a).norm() +
                            (supportMatrix(b) - previous.l_b).norm();
       bool safe = previous.outside_bound + drift < best.s;
+      const double rho = previous.watch_count > 0 ? directionSet(previous.sample_directions).rho : 0.0;
       for (int k = 0; k < previous.watch_count && safe; ++k)
         if (!(previous.watch_bounds[k] + drift < best.s))
-          safe = dual.capBound(dual.eval(previous.watch[k]), directionSet(previous.sample_directions)) < best.s;
+          safe = dual.capBelow(previous.watch[k], rho, best.s, kRefinements);
       for (int k = 0; k < previous.rival_count && safe; ++k) {
         if (previous.rival_ceilings[k] + drift < best.s) continue;
         const DualPoint r = dual.eval(previous.rivals[k]);
@@ -385,46 +434,33 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     summary.global_search = true;
     const DirectionSet& set = directionSet(options.sample_directions);
     const int n = set.count;
-    thread_local std::vector<double> s, initial, bound;  // bound: -inf once settled
+    thread_local std::vector<double> s, initial, bound;  // bound: -inf once ascended from or settled
     s.resize(static_cast<size_t>(n));
     initial.resize(static_cast<size_t>(n));
     boundDual(set, dual, s.data(), initial.data());
     bound = initial;
     thread_local std::vector<Vector3d> found;  // maxima reached so far
-    thread_local std::vector<int> ascended;  // samples ascended from
     found.clear();
-    ascended.clear();
-    auto settle = [&](const DualPoint& maximum) {
-      found.push_back(maximum.v);
-      for (int i = 0; i < n; ++i)
-        if (set.directions[static_cast<size_t>(i)].dot(maximum.v) >= set.cos_settled) bound[static_cast<size_t>(i)] = -INFINITY;
+    auto settle = [&](const Vector3d& maximum) {
+      found.push_back(maximum);
+      settleSamples(set, maximum, bound.data());
     };
-    if (converged) settle(best);
+    if (converged) settle(best.v);
     const double margin = 1e-12 * dual.length;
     bool open = true;  // the ascent limit stopped the search before every cap was below the answer
     for (int ascents = 0; ascents < kMaxAscents; ++ascents) {
-      // (Branch-free scan: unpredictable comparisons made a branchy scan slow, perf.)
-      const double* order = found.empty() ? s.data() : bound.data();
-      int top = -1;
-      double top_value = converged ? best.s + margin : -INFINITY;
-      for (int i = 0; i < n; ++i) {
-        const double value = bound[static_cast<size_t>(i)] == -INFINITY ? -INFINITY : order[i];
-        const bool better = value > top_value;
-        top = better ? i : top;
-        top_value = better ? value : top_value;
-      }
+      const int top = found.empty() ? highestAbove(s.data(), n, -INFINITY) : highestAbove(bound.data(), n, best.s + margin);
       if (top < 0) {
         open = false;
         break;
       }
       bound[static_cast<size_t>(top)] = -INFINITY;
-      ascended.push_back(top);
-      if (const DualPoint* end = consider(dual.eval(set.directions[static_cast<size_t>(top)]), &found)) settle(*end);
+      s[static_cast<size_t>(top)] = -INFINITY;
+      if (const DualPoint* end = consider(dual.eval(set.directions[static_cast<size_t>(top)]), &found)) settle(end->v);
     }
     // For warm starts: where the other ascents ended (maxima, or where an
-    // ascent gave up) are the rivals the next step follows; the caps of the
-    // samples no ascent started from and no maximum settled (all bounded
-    // below the answer) are summed up by their highest bounds, the first few
+    // ascent gave up) are the rivals the next step follows; the caps no
+    // maximum settled are summed up by their highest bounds, the first few
     // watched one by one and the rest by one bound.
     DualSearchState& state = result.search;
     std::sort(ends.begin(), ends.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
@@ -444,12 +480,11 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     constexpr int kKept = DualSearchState::kWatched + 1;
     std::pair<double, int> highest[kKept];
     std::fill(highest, highest + kKept, std::make_pair(-INFINITY, -1));
+    // (A sample an ascent left keeps its bound: where that ascent went says
+    // nothing about its cap once the pair has moved.)
+    for (const Vector3d& f : found) settleSamples(set, f, initial.data());
     for (int i = 0; i < n; ++i) {
-      const Vector3d& w = set.directions[static_cast<size_t>(i)];
-      if (std::find(ascended.begin(), ascended.end(), i) != ascended.end() ||
-          std::any_of(found.begin(), found.end(), [&](const Vector3d& f) { return f.dot(w) >= set.cos_settled; }))
-        continue;
-      const double value = initial[static_cast<size_t>(i)];
+      const double value = initial[static_cast<size_t>(i)];  // -inf: settled
       int k = kKept;
       for (; k > 0 && highest[k - 1].first < value; --k)
         if (k < kKept) highest[k] = highest[k - 1];

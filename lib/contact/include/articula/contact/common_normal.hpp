@@ -78,14 +78,13 @@ struct ContactSummary {
 /// search's pose (L = D R^T of each shape, c_B - c_A). The dual has moved by
 /// at most |delta c| + |delta L_A|_F + |delta L_B|_F since.
 struct DualSearchState {
-  static constexpr int kRivals = 3, kWatched = 4;
+  static constexpr int kRivals = 3, kWatched = 8;
   int rival_count = -1;  // -1: no global search behind this result
-  Eigen::Vector3d rivals[kRivals] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  double rival_ceilings[kRivals] = {INFINITY, INFINITY, INFINITY};
+  Eigen::Vector3d rivals[kRivals];  // (set where rival_count says)
+  double rival_ceilings[kRivals] = {};
   int watch_count = 0;
-  Eigen::Vector3d watch[kWatched] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                                     Eigen::Vector3d::Zero()};
-  double watch_bounds[kWatched] = {INFINITY, INFINITY, INFINITY, INFINITY};
+  Eigen::Vector3d watch[kWatched];   // (set where watch_count says)
+  double watch_bounds[kWatched] = {};
   int sample_directions = 0;        // of the search (the caps' radius)
   double outside_bound = INFINITY;  // s beyond the answer, the rivals and the watched caps
   Eigen::Matrix3d l_a = Eigen::Matrix3d::Zero(), l_b = Eigen::Matrix3d::Zero();
