@@ -21,6 +21,9 @@ constexpr double kSame = 0.999;     // an ascent this close to a maximum reached
 constexpr double kMoved = 0.98;     // a warm ascent that turned the normal further may have changed basin
 constexpr double kGradientTolerance = 1e-11;  // |tangential grad s| / length
 constexpr int kRefinements = 2;  // a warm start splits a watched cap this often before searching again
+// cos and sin of k pi / 3: the six caps around a split cap's centre.
+constexpr double kHexagon[6][2] = {{1.0, 0.0}, {0.5, 0.8660254037844386}, {-0.5, 0.8660254037844386},
+                                   {-1.0, 0.0}, {-0.5, -0.8660254037844386}, {0.5, -0.8660254037844386}};
 
 // Antipodal directions (a Fibonacci lattice on the upper half, then its
 // negation); the upper half's coordinates again as separate arrays, so that
@@ -148,8 +151,9 @@ struct Dual {
     length = std::max(a.radii.maxCoeff(), b.radii.maxCoeff());
     max_radius_a = a.radii.maxCoeff();
     max_radius_b = b.radii.maxCoeff();
-    curvature_a = std::pow(a.radii.prod() / max_radius_a, 2);
-    curvature_b = std::pow(b.radii.prod() / max_radius_b, 2);
+    const double mid_min_a = a.radii.prod() / max_radius_a, mid_min_b = b.radii.prod() / max_radius_b;
+    curvature_a = mid_min_a * mid_min_a;
+    curvature_b = mid_min_b * mid_min_b;
     gradient_tolerance = kGradientTolerance * length;
   }
 
@@ -170,23 +174,23 @@ struct Dual {
                                        std::sin(rho));
   }
 
-  // Whether s stays below `beat` on the cap of radius rho around w: by its
-  // bound, else (depth > 0) by covering the cap with 7 caps of radius
-  // 0.55 rho, one at w and six around it at 0.866 rho, and asking each (in
-  // the plane, radius rho / 2 just covers; 0.55 leaves room for the sphere's
-  // curvature at rho <= 0.5).
-  bool capBelow(const Vector3d& w, double rho, double beat, int depth) const {
-    if (capBound(eval(w), rho) < beat) return true;
-    if (depth == 0) return false;
-    const double small = 0.55 * rho, ring = 0.866 * rho;
+  // An upper bound of s on the cap of radius rho around w, below `beat` if
+  // the cap can be shown to be: the cap's own bound, else (depth > 0) the
+  // highest of 7 caps of radius 0.55 rho that cover it, one at w and six
+  // around it at 0.866 rho (in the plane, radius rho / 2 just covers; 0.55
+  // leaves room for the sphere's curvature at rho <= 0.5). Stops at the first
+  // child that stays at or above `beat`.
+  double refinedCapBound(const Vector3d& w, double rho, double beat, int depth) const {
+    const double own = capBound(eval(w), rho);
+    if (own < beat || depth == 0) return own;
+    const double small = 0.55 * rho, ring = 0.866 * rho, cos_ring = std::cos(ring), sin_ring = std::sin(ring);
     const geometry::TangentFrame f = geometry::householderFrameUnit(w);
-    if (!capBelow(w, small, beat, depth - 1)) return false;
-    for (int k = 0; k < 6; ++k) {
-      const double angle = k * M_PI / 3.0;
-      const Vector3d t = std::cos(angle) * f.t + std::sin(angle) * f.b;
-      if (!capBelow(std::cos(ring) * w + std::sin(ring) * t, small, beat, depth - 1)) return false;
+    double highest = refinedCapBound(w, small, beat, depth - 1);
+    for (int k = 0; k < 6 && highest < beat; ++k) {
+      const Vector3d t = kHexagon[k][0] * f.t + kHexagon[k][1] * f.b;
+      highest = std::max(highest, refinedCapBound(cos_ring * w + sin_ring * t, small, beat, depth - 1));
     }
-    return true;
+    return highest;
   }
 
   DualPoint eval(const Vector3d& v) const {
@@ -407,7 +411,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
       const double rho = previous.watch_count > 0 ? directionSet(previous.sample_directions).rho : 0.0;
       for (int k = 0; k < previous.watch_count && safe; ++k)
         if (!(previous.watch_bounds[k] + drift < best.s))
-          safe = dual.capBelow(previous.watch[k], rho, best.s, kRefinements);
+          safe = dual.refinedCapBound(previous.watch[k], rho, best.s, kRefinements) < best.s;
       for (int k = 0; k < previous.rival_count && safe; ++k) {
         if (previous.rival_ceilings[k] + drift < best.s) continue;
         const DualPoint r = dual.eval(previous.rivals[k]);

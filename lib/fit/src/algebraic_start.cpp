@@ -7,6 +7,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/geometry/pose.hpp"
+#include "articula/geometry/sphere_fit.hpp"
 
 namespace articula::fit {
 
@@ -37,19 +38,11 @@ Normalised normalise(const Eigen::MatrixX3d& points) {
 }  // namespace
 
 ShapeParameters algebraicSphere(const Eigen::MatrixX3d& points) {
-  const Normalised n = normalise(points);
-  MatrixXd A(n.points.rows(), 4);
-  A.leftCols<3>() = 2.0 * n.points;
-  A.col(3).setOnes();
-  const Eigen::VectorXd b = n.points.rowwise().squaredNorm();
-  const Eigen::Vector4d s = A.colPivHouseholderQr().solve(b);
-  const Vector3d c = s.head<3>();
-  const double r2 = s[3] + c.squaredNorm();
-  if (!s.allFinite() || !(r2 > 0.0)) throw ProcessingError("algebraic sphere fit failed: points are degenerate");
+  const geometry::Sphere sphere = geometry::fitSphere(points);
   ShapeParameters p;
   p.model = ShapeModel::Sphere;
-  p.center = n.centroid + n.scale * c;
-  p.radii.setConstant(n.scale * std::sqrt(r2));
+  p.center = sphere.center;
+  p.radii.setConstant(sphere.radius);
   return p;
 }
 

@@ -14,6 +14,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/geometry/sphere_fit.hpp"
 
 namespace articula::sampling {
 namespace {
@@ -99,17 +100,6 @@ void parseSelection(const std::string& text, SelectOptions& o) {
   o.validate();
 }
 
-void fitSphere(const Eigen::MatrixX3d& P, Eigen::Vector3d& center, double& radius) {
-  // |x|^2 = 2 c.x + (r^2 - |c|^2): linear in (c, d).
-  Eigen::MatrixXd A(P.rows(), 4);
-  A.leftCols<3>() = 2.0 * P;
-  A.col(3).setOnes();
-  const Eigen::VectorXd b = P.rowwise().squaredNorm();
-  const Eigen::Vector4d s = A.colPivHouseholderQr().solve(b);
-  center = s.head<3>();
-  radius = std::sqrt(std::max(0.0, s[3] + center.squaredNorm()));
-}
-
 Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
                           const SelectOptions& o) {
   o.validate();
@@ -159,7 +149,9 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
         if (static_cast<int>(patch.indices.size()) < std::max(o.min_points, 4)) break;
         Eigen::MatrixX3d P(static_cast<Eigen::Index>(patch.indices.size()), 3);
         for (size_t i = 0; i < patch.indices.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(patch.indices[i]);
-        fitSphere(P, patch.sphere_center, patch.sphere_radius);
+        const geometry::Sphere sphere = geometry::fitSphere(P);
+        patch.sphere_center = sphere.center;
+        patch.sphere_radius = sphere.radius;
         patch.sphere_rms_mm = std::sqrt(
             ((P.rowwise() - patch.sphere_center.transpose()).rowwise().norm().array() - patch.sphere_radius).square().mean());
       }

@@ -44,7 +44,7 @@ struct ContactOptions {
   double step_tolerance = 1e-13;    // stop when |delta u| (canonical, dimensionless) is below
   double residual_tolerance = 1e-14;  // or when |Phi| (dimensionless) is below
   int sample_directions = 64;       // dual samples for the global search (overlap)
-  int global_starts = 3;            // Newton starts from the best distinct samples
+  int global_starts = 3;            // common-normal system: Newton starts from the best distinct samples
   bool verify_warm_overlap = false;  // warm start and overlap: also run the global search
   /// Throws UsageError naming the first bad field.
   void validate() const;

@@ -45,7 +45,4 @@ struct Selection {
 Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
                           const SelectOptions& options);
 
-/// Least-squares (algebraic) sphere through the rows of P (#P x 3): centre, radius.
-void fitSphere(const Eigen::MatrixX3d& P, Eigen::Vector3d& center, double& radius);
-
 }  // namespace articula::sampling
