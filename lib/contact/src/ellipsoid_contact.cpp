@@ -1,7 +1,6 @@
 #include "articula/contact/ellipsoid_contact.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <map>
 #include <vector>
