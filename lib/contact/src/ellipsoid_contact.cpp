@@ -147,9 +147,9 @@ struct Dual {
 
   Dual(const ConvexShape& a, const ConvexShape& b)
       : ma(shapeMatrix(a)), mb(shapeMatrix(b)), c(b.center - a.center) {
-    length = std::max(a.radii.maxCoeff(), b.radii.maxCoeff());
     max_radius_a = a.radii.maxCoeff();
     max_radius_b = b.radii.maxCoeff();
+    length = std::max(max_radius_a, max_radius_b);
     const double mid_min_a = a.radii.prod() / max_radius_a, mid_min_b = b.radii.prod() / max_radius_b;
     curvature_a = mid_min_a * mid_min_a;
     curvature_b = mid_min_b * mid_min_b;
@@ -167,10 +167,9 @@ struct Dual {
     return curvature_a / (la * la * la) + curvature_b / (lb * lb * lb);
   }
 
-  // capBound on the cap of `set` around p.v.
-  double capBound(const DualPoint& p, double rho) const {
-    return articula::contact::capBound(p.s, p.g.squaredNorm(), curvatureBound(p.ha, p.hb, rho), std::cos(rho),
-                                       std::sin(rho));
+  // capBound on the cap of radius rho around p.v.
+  double capBound(const DualPoint& p, double rho, double cos_rho, double sin_rho) const {
+    return articula::contact::capBound(p.s, p.g.squaredNorm(), curvatureBound(p.ha, p.hb, rho), cos_rho, sin_rho);
   }
 
   // An upper bound of s on the cap of radius rho around w, below `beat` if
@@ -180,14 +179,20 @@ struct Dual {
   // leaves room for the sphere's curvature at rho <= 0.5). Stops at the first
   // child that stays at or above `beat`.
   double refinedCapBound(const Vector3d& w, double rho, double beat, int depth) const {
-    const double own = capBound(eval(w), rho);
+    return refinedCapBound(eval(w), rho, std::cos(rho), std::sin(rho), beat, depth);
+  }
+  double refinedCapBound(const DualPoint& p, double rho, double cos_rho, double sin_rho, double beat,
+                         int depth) const {
+    const double own = capBound(p, rho, cos_rho, sin_rho);
     if (own < beat || depth == 0) return own;
-    const double small = 0.55 * rho, ring = 0.866 * rho, cos_ring = std::cos(ring), sin_ring = std::sin(ring);
-    const geometry::TangentFrame f = geometry::householderFrameUnit(w);
-    double highest = refinedCapBound(w, small, beat, depth - 1);
+    const double small = 0.55 * rho, cos_small = std::cos(small), sin_small = std::sin(small);
+    const double ring = 0.866 * rho, cos_ring = std::cos(ring), sin_ring = std::sin(ring);
+    const geometry::TangentFrame f = geometry::householderFrameUnit(p.v);
+    double highest = refinedCapBound(p, small, cos_small, sin_small, beat, depth - 1);  // the centre cap
     for (int k = 0; k < 6 && highest < beat; ++k) {
       const Vector3d t = kHexagon[k][0] * f.t + kHexagon[k][1] * f.b;
-      highest = std::max(highest, refinedCapBound(cos_ring * w + sin_ring * t, small, beat, depth - 1));
+      highest = std::max(highest, refinedCapBound(eval(cos_ring * p.v + sin_ring * t), small, cos_small, sin_small,
+                                                  beat, depth - 1));
     }
     return highest;
   }
@@ -407,10 +412,9 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
       const double drift = (dual.c - previous.offset).norm() + (supportMatrix(a) - previous.l_a).norm() +
                            (supportMatrix(b) - previous.l_b).norm();
       bool safe = previous.outside_bound + drift < best.s;
-      const double rho = previous.watch_count > 0 ? directionSet(previous.sample_directions).rho : 0.0;
       for (int k = 0; k < previous.watch_count && safe; ++k)
         if (!(previous.watch_bounds[k] + drift < best.s))
-          safe = dual.refinedCapBound(previous.watch[k], rho, best.s, kRefinements) < best.s;
+          safe = dual.refinedCapBound(previous.watch[k], previous.cap_radius, best.s, kRefinements) < best.s;
       for (int k = 0; k < previous.rival_count && safe; ++k) {
         if (previous.rival_ceilings[k] + drift < best.s) continue;
         const DualPoint r = dual.eval(previous.rivals[k]);
@@ -499,7 +503,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
       state.watch[state.watch_count++] = set.directions[static_cast<size_t>(highest[k].second)];
     }
     state.outside_bound = untracked ? INFINITY : highest[kKept - 1].first;
-    state.sample_directions = set.count;
+    state.cap_radius = set.rho;
     state.l_a = supportMatrix(a);
     state.l_b = supportMatrix(b);
     state.offset = dual.c;

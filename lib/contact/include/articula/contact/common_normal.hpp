@@ -85,7 +85,7 @@ struct DualSearchState {
   int watch_count = 0;
   Eigen::Vector3d watch[kWatched];   // (set where watch_count says)
   double watch_bounds[kWatched] = {};
-  int sample_directions = 0;        // of the search (the caps' radius)
+  double cap_radius = 0.0;          // of the search's sample caps (rad)
   double outside_bound = INFINITY;  // s beyond the answer, the rivals and the watched caps
   Eigen::Matrix3d l_a = Eigen::Matrix3d::Zero(), l_b = Eigen::Matrix3d::Zero();
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
