@@ -74,6 +74,19 @@ TEST(ConvexShape, SupportPointHasTheGivenNormal) {
   }
 }
 
+TEST(ConvexShape, SupportPointOfANearlyAxialDirectionIsFinite) {
+  // Components far below the largest (down to subnormal ratios) and exact
+  // zeros: the support point stays on the surface with the given normal.
+  const ConvexShape s = makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 2, 3), Vector3d(40, 3, 2));
+  for (const Vector3d& v : {Vector3d(1, 1e-310, 0), Vector3d(1e-320, -1, 1e-200), Vector3d(0, 0, -1)}) {
+    const Vector3d u = supportCanonical(s, v);
+    ASSERT_TRUE(u.allFinite()) << v.transpose();
+    EXPECT_NEAR(evaluateCanonical(s, u).value, 0.0, 1e-13);
+    const Vector3d n = (s.rotation * evaluateCanonical(s, u).gradient.cwiseQuotient(s.radii)).normalized();
+    EXPECT_GT(n.dot(v.normalized()), 1.0 - 1e-13);
+  }
+}
+
 TEST(ConvexShape, RejectsBadParameters) {
   EXPECT_THROW(makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 0, 1)), articula::InvalidParameter);
   EXPECT_THROW(makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 1, 1), Vector3d(2, 1.5, 2)),

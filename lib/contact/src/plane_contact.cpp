@@ -45,7 +45,8 @@ ContactResult pickCandidate(const Vector3d& center, const Vector3d& x_plus, cons
 ContactResult shapePlaneContact(const ConvexShape& shape, const Vector3d& plane_point, const Vector3d& plane_normal) {
   const Vector3d n = unitPlaneNormal(plane_normal);
   // Candidate with outward normal -n (facing the plane); its mirror faces away.
-  const Vector3d u = supportCanonical(shape, -n);
+  // (The support mapping takes any length: the normalisation stays off its path.)
+  const Vector3d u = supportCanonical(shape, -plane_normal);
   return pickCandidate(shape.center, toGlobal(shape, u), u, plane_point, n);
 }
 
