@@ -19,7 +19,7 @@ constexpr int kMaxAscents = 64;   // Newton ascents from samples, at most
 constexpr double kSame = 0.999;     // an ascent this close to a maximum reached goes there
 constexpr double kMoved = 0.98;     // a warm ascent that turned the normal further may have changed basin
 constexpr double kGradientTolerance = 1e-11;  // |tangential grad s| / length
-constexpr int kRefinements = 2;  // a warm start splits a watched cap this often before searching again
+constexpr int kRefinements = 2;  // a warm start splits a watched cap this many levels deep before searching again
 // cos and sin of k pi / 3: the six caps around a split cap's centre.
 constexpr double kHexagon[6][2] = {{1.0, 0.0}, {0.5, 0.8660254037844386}, {-0.5, 0.8660254037844386},
                                    {-1.0, 0.0}, {-0.5, -0.8660254037844386}, {0.5, -0.8660254037844386}};
@@ -178,21 +178,37 @@ struct Dual {
   // around it at 0.866 rho (in the plane, radius rho / 2 just covers; 0.55
   // leaves room for the sphere's curvature at rho <= 0.5). Stops at the first
   // child that stays at or above `beat`.
-  double refinedCapBound(const Vector3d& w, double rho, double beat, int depth) const {
-    return refinedCapBound(eval(w), rho, std::cos(rho), std::sin(rho), beat, depth);
+  double refinedCapBound(const Vector3d& w, double rho, double beat) const {
+    return refinedCapBound(eval(w), capLevels(rho), 0, beat);
   }
-  double refinedCapBound(const DualPoint& p, double rho, double cos_rho, double sin_rho, double beat,
-                         int depth) const {
-    const double own = capBound(p, rho, cos_rho, sin_rho);
-    if (own < beat || depth == 0) return own;
-    const double small = 0.55 * rho, cos_small = std::cos(small), sin_small = std::sin(small);
-    const double ring = 0.866 * rho, cos_ring = std::cos(ring), sin_ring = std::sin(ring);
+
+  // The radii of a cap and of its refinements, level by level, with their
+  // cosines and sines: computed once per radius (the sample set's), as the
+  // warm path bounds several caps per call.
+  struct CapLevels {
+    double rho[kRefinements + 1], cos_rho[kRefinements + 1], sin_rho[kRefinements + 1];
+    double cos_ring[kRefinements + 1], sin_ring[kRefinements + 1];  // of 0.866 rho: where a level's six caps sit
+  };
+  static const CapLevels& capLevels(double rho) {
+    thread_local CapLevels levels{{NAN}, {}, {}, {}, {}};
+    if (levels.rho[0] == rho) return levels;
+    for (int l = 0; l <= kRefinements; ++l, rho *= 0.55) {
+      levels.rho[l] = rho;
+      levels.cos_rho[l] = std::cos(rho), levels.sin_rho[l] = std::sin(rho);
+      levels.cos_ring[l] = std::cos(0.866 * rho), levels.sin_ring[l] = std::sin(0.866 * rho);
+    }
+    return levels;
+  }
+
+  double refinedCapBound(const DualPoint& p, const CapLevels& levels, int level, double beat) const {
+    const double own = capBound(p, levels.rho[level], levels.cos_rho[level], levels.sin_rho[level]);
+    if (own < beat || level == kRefinements) return own;
     const geometry::TangentFrame f = geometry::householderFrameUnit(p.v);
-    double highest = refinedCapBound(p, small, cos_small, sin_small, beat, depth - 1);  // the centre cap
+    double highest = refinedCapBound(p, levels, level + 1, beat);  // the centre cap
     for (int k = 0; k < 6 && highest < beat; ++k) {
       const Vector3d t = kHexagon[k][0] * f.t + kHexagon[k][1] * f.b;
-      highest = std::max(highest, refinedCapBound(eval(cos_ring * p.v + sin_ring * t), small, cos_small, sin_small,
-                                                  beat, depth - 1));
+      highest = std::max(highest, refinedCapBound(eval(levels.cos_ring[level] * p.v + levels.sin_ring[level] * t),
+                                                  levels, level + 1, beat));
     }
     return highest;
   }
@@ -414,7 +430,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
       bool safe = previous.outside_bound + drift < best.s;
       for (int k = 0; k < previous.watch_count && safe; ++k)
         if (!(previous.watch_bounds[k] + drift < best.s))
-          safe = dual.refinedCapBound(previous.watch[k], previous.cap_radius, best.s, kRefinements) < best.s;
+          safe = dual.refinedCapBound(previous.watch[k], previous.cap_radius, best.s) < best.s;
       for (int k = 0; k < previous.rival_count && safe; ++k) {
         if (previous.rival_ceilings[k] + drift < best.s) continue;
         const DualPoint r = dual.eval(previous.rivals[k]);
