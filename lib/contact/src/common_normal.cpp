@@ -11,6 +11,7 @@
 #include "articula/contact/ellipsoid_contact.hpp"
 #include "articula/contact/frame_derivatives.hpp"
 #include "articula/core/error.hpp"
+#include "articula/geometry/fibonacci.hpp"
 
 namespace articula::contact {
 
@@ -146,12 +147,7 @@ const std::vector<Vector3d>& sphereDirections(int count) {
   thread_local std::vector<Vector3d> cache;
   if (static_cast<int>(cache.size()) != count) {
     cache.resize(static_cast<size_t>(count));
-    const double golden = M_PI * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < count; ++i) {
-      const double z = 1.0 - (2.0 * i + 1.0) / count;
-      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-      cache[static_cast<size_t>(i)] = Vector3d(r * std::cos(golden * i), r * std::sin(golden * i), z);
-    }
+    for (int i = 0; i < count; ++i) cache[static_cast<size_t>(i)] = geometry::fibonacciDirection(i, count);
   }
   return cache;
 }

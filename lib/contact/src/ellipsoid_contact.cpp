@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "articula/core/error.hpp"
+#include "articula/geometry/fibonacci.hpp"
 #include "articula/geometry/frames.hpp"
 
 namespace articula::contact {
@@ -51,11 +52,8 @@ const DirectionSet& directionSet(int count) {
   set.x.resize(static_cast<size_t>(half));
   set.y.resize(static_cast<size_t>(half));
   set.z.resize(static_cast<size_t>(half));
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < half; ++i) {
-    const double z = 1.0 - (i + 0.5) / half;  // (0, 1): the upper half
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Vector3d v(r * std::cos(golden * i), r * std::sin(golden * i), z);
+    const Vector3d v = geometry::fibonacciDirection(i, half, 0.0);  // the upper half
     set.directions[static_cast<size_t>(i)] = v;
     set.directions[static_cast<size_t>(i + half)] = -v;
     set.x[static_cast<size_t>(i)] = v.x();
@@ -67,7 +65,8 @@ const DirectionSet& directionSet(int count) {
   const int probes = 4000;
   for (int p = 0; p < probes; ++p) {
     const double z = 1.0 - (2.0 * p + 1.0) / probes, r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Vector3d w(r * std::cos(golden * p * 1.0001), r * std::sin(golden * p * 1.0001), z);
+    const double azimuth = M_PI * (3.0 - std::sqrt(5.0)) * p * 1.0001;  // off the lattice's own angles
+    const Vector3d w(r * std::cos(azimuth), r * std::sin(azimuth), z);
     double nearest = -1.0;
     for (const Vector3d& d : set.directions) nearest = std::max(nearest, d.dot(w));
     cos_cover = std::min(cos_cover, nearest);
@@ -179,7 +178,7 @@ struct Dual {
   // leaves room for the sphere's curvature at rho <= 0.5). Stops at the first
   // child that stays at or above `beat`.
   double refinedCapBound(const Vector3d& w, double rho, double beat) const {
-    return refinedCapBound(eval(w), capLevels(rho), 0, beat);
+    return refinedCapBound<0>(eval(w), capLevels(rho), beat);
   }
 
   // The radii of a cap and of its refinements, level by level, with their
@@ -200,17 +199,22 @@ struct Dual {
     return levels;
   }
 
-  double refinedCapBound(const DualPoint& p, const CapLevels& levels, int level, double beat) const {
+  template <int level>
+  double refinedCapBound(const DualPoint& p, const CapLevels& levels, double beat) const {
     const double own = capBound(p, levels.rho[level], levels.cos_rho[level], levels.sin_rho[level]);
-    if (own < beat || level == kRefinements) return own;
-    const geometry::TangentFrame f = geometry::householderFrameUnit(p.v);
-    double highest = refinedCapBound(p, levels, level + 1, beat);  // the centre cap
-    for (int k = 0; k < 6 && highest < beat; ++k) {
-      const Vector3d t = kHexagon[k][0] * f.t + kHexagon[k][1] * f.b;
-      highest = std::max(highest, refinedCapBound(eval(levels.cos_ring[level] * p.v + levels.sin_ring[level] * t),
-                                                  levels, level + 1, beat));
+    if constexpr (level == kRefinements) {
+      return own;
+    } else {
+      if (own < beat) return own;
+      const geometry::TangentFrame f = geometry::householderFrameUnit(p.v);
+      double highest = refinedCapBound<level + 1>(p, levels, beat);  // the centre cap
+      for (int k = 0; k < 6 && highest < beat; ++k) {
+        const Vector3d t = kHexagon[k][0] * f.t + kHexagon[k][1] * f.b;
+        highest = std::max(highest, refinedCapBound<level + 1>(
+                                        eval(levels.cos_ring[level] * p.v + levels.sin_ring[level] * t), levels, beat));
+      }
+      return highest;
     }
-    return highest;
   }
 
   DualPoint eval(const Vector3d& v) const {

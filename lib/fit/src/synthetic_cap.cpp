@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include "articula/geometry/fibonacci.hpp"
 #include "articula/geometry/surface.hpp"
 
 namespace articula::fit {
@@ -13,12 +14,8 @@ Eigen::MatrixX3d syntheticCap(const geometry::ShapeParameters& shape, double hal
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, sigma > 0.0 ? sigma : 1.0);
   Eigen::MatrixX3d pts(n, 3);
-  const double z_min = std::cos(half_angle);
   for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (1.0 - z_min) * (i + 0.5) / n;
-    const double azimuth = i * M_PI * (3.0 - std::sqrt(5.0));
-    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Eigen::Vector3d dir(rho * std::cos(azimuth), rho * std::sin(azimuth), z);
+    const Eigen::Vector3d dir = geometry::fibonacciDirection(i, n, std::cos(half_angle));
     // The body is convex and holds its local origin: one crossing per ray.
     double lo = 0.0, hi = 1.0;
     while (s->evaluateCanonical(hi * dir, 0).value < 0.0) hi *= 2.0;

@@ -18,6 +18,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/geometry/sphere_fit.hpp"
 #include "itk_bridge.hpp"
 
 namespace articula::imaging {
@@ -215,26 +216,23 @@ bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector
     p.radius = distances[distances.size() / 2];
     size_t used = 0;
     for (int iteration = 0; iteration < 5; ++iteration) {
-      // |x|^2 = 2 c.x + (r^2 - |c|^2): linear in c and the constant.
-      Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-      Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-      used = 0;
+      std::vector<Eigen::Vector3d> facing;  // surface voxels near the sphere, their normals towards its centre
       for (const Voter& voter : voters) {
         const Eigen::Vector3d d = p.x - voter.x;
         const double t = d.norm();
-        if (std::abs(t - p.radius) > 0.25 * p.radius || d.dot(voter.n) < 0.9 * t) continue;
-        const Eigen::Vector4d row(2 * voter.x[0], 2 * voter.x[1], 2 * voter.x[2], 1.0);
-        normal += row * row.transpose();
-        rhs += row * voter.x.squaredNorm();
-        ++used;
+        if (std::abs(t - p.radius) <= 0.25 * p.radius && d.dot(voter.n) >= 0.9 * t) facing.push_back(voter.x);
       }
+      used = facing.size();
       if (used < 10) break;
-      const Eigen::Vector4d sol = normal.ldlt().solve(rhs);
-      const Eigen::Vector3d c = sol.head<3>();
-      const double r2 = sol[3] + c.squaredNorm();
-      if (!(r2 > 0)) break;
-      p.x = c;
-      p.radius = std::sqrt(r2);
+      Eigen::MatrixX3d points(static_cast<Eigen::Index>(used), 3);
+      for (size_t i = 0; i < used; ++i) points.row(static_cast<Eigen::Index>(i)) = facing[i].transpose();
+      try {
+        const geometry::Sphere sphere = geometry::fitSphere(points);
+        p.x = sphere.center;
+        p.radius = sphere.radius;
+      } catch (const ProcessingError&) {
+        break;  // degenerate support (a flat or tiny patch): keep the Hough estimate
+      }
     }
     p.coverage = used * cell_area / (4 * M_PI * p.radius * p.radius);
     log::debug("head candidate " + vec(p.x) + " mm: " + std::to_string(p.votes) + " votes, radius " +
