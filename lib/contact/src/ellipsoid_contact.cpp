@@ -370,17 +370,30 @@ void settleSamples(const DirectionSet& set, const Vector3d& maximum, double* __r
   }
 }
 
-// The index of the largest value above `floor`, or -1. (Branch-free: with
-// unpredictable comparisons, branches made such scans slow, perf.)
+// The index of the largest value above `floor` (the first of equal ones), or
+// -1. Branch-free (with unpredictable comparisons, branches made such scans
+// slow, perf), and in four interleaved lanes merged at the end: one lane's
+// chain of dependent compare-selects made the scan latency-bound (callgrind).
 int highestAbove(const double* values, int n, double floor) {
-  int top = -1;
-  double top_value = floor;
-  for (int i = 0; i < n; ++i) {
-    const bool better = values[i] > top_value;
-    top = better ? i : top;
-    top_value = better ? values[i] : top_value;
-  }
-  return top;
+  constexpr int kLanes = 4;
+  int top[kLanes];
+  double top_value[kLanes];
+  std::fill(top, top + kLanes, -1);
+  std::fill(top_value, top_value + kLanes, floor);
+  for (int i = 0; i < n; i += kLanes)
+    for (int lane = 0; lane < kLanes && i + lane < n; ++lane) {
+      const bool better = values[i + lane] > top_value[lane];
+      top[lane] = better ? i + lane : top[lane];
+      top_value[lane] = better ? values[i + lane] : top_value[lane];
+    }
+  int best = -1;
+  double best_value = floor;
+  for (int lane = 0; lane < kLanes; ++lane)
+    if (top[lane] >= 0 && (top_value[lane] > best_value || (top_value[lane] == best_value && top[lane] < best))) {
+      best = top[lane];
+      best_value = top_value[lane];
+    }
+  return best;
 }
 
 }  // namespace
