@@ -43,6 +43,15 @@ Pose makePose(const ShapeParameters& p) {
 Vector3d unitSpherePoint(double azimuth, double latitude) {
   return {std::cos(latitude) * std::cos(azimuth), std::cos(latitude) * std::sin(azimuth), std::sin(latitude)};
 }
+
+// F = |u|^2 - 1: the canonical form of the sphere and of the ellipsoid (the pose scales it).
+Evaluation unitSphereEvaluation(const Vector3d& u, int order) {
+  Evaluation e;
+  e.value = u.squaredNorm() - 1.0;
+  if (order >= 1) e.gradient = 2.0 * u;
+  if (order >= 2) e.hessian = 2.0 * Matrix3d::Identity();
+  return e;
+}
 }  // namespace
 
 std::unique_ptr<PosedSurface> makeSurface(const ShapeParameters& p) {
@@ -84,13 +93,7 @@ Evaluation Sphere::evaluate(const Vector3d& x, int order) const {
   return e;
 }
 
-Evaluation Sphere::evaluateCanonical(const Vector3d& u, int order) const {
-  Evaluation e;
-  e.value = u.squaredNorm() - 1.0;
-  if (order >= 1) e.gradient = 2.0 * u;
-  if (order >= 2) e.hessian = 2.0 * Matrix3d::Identity();
-  return e;
-}
+Evaluation Sphere::evaluateCanonical(const Vector3d& u, int order) const { return unitSphereEvaluation(u, order); }
 
 Vector3d Sphere::canonicalPoint(double azimuth, double latitude) const {
   return unitSpherePoint(azimuth, latitude);
@@ -98,13 +101,7 @@ Vector3d Sphere::canonicalPoint(double azimuth, double latitude) const {
 
 // ---------------------------------------------------------------- ellipsoid
 
-Evaluation Ellipsoid::evaluateCanonical(const Vector3d& u, int order) const {
-  Evaluation e;
-  e.value = u.squaredNorm() - 1.0;
-  if (order >= 1) e.gradient = 2.0 * u;
-  if (order >= 2) e.hessian = 2.0 * Matrix3d::Identity();
-  return e;
-}
+Evaluation Ellipsoid::evaluateCanonical(const Vector3d& u, int order) const { return unitSphereEvaluation(u, order); }
 
 Vector3d Ellipsoid::canonicalPoint(double azimuth, double latitude) const {
   return unitSpherePoint(azimuth, latitude);
