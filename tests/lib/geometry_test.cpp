@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
+#include "articula/geometry/fibonacci.hpp"
 #include "articula/geometry/power.hpp"
 #include "articula/geometry/surfaces.hpp"
 
@@ -97,6 +98,36 @@ void expectClose(double fd, double exact, double scale, double rel, const std::s
 }
 
 }  // namespace
+
+TEST(FibonacciLattice, CoversItsCapEvenly) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> normal;
+  const int count = 500;
+  for (double z_min : {-1.0, 0.0, 0.5}) {
+    std::vector<Eigen::Vector3d> lattice;
+    int upper_half = 0;  // of the cap's area: above z = (1 + z_min) / 2
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector3d v = g::fibonacciDirection(i, count, z_min);
+      EXPECT_NEAR(v.norm(), 1.0, 1e-15);
+      EXPECT_GE(v.z(), z_min);
+      upper_half += v.z() > 0.5 * (1.0 + z_min);
+      lattice.push_back(v);
+    }
+    EXPECT_NEAR(upper_half, count / 2, 1) << z_min;  // equal areas
+    // Every direction of the cap lies within about the spacing of a lattice point.
+    const double spacing = std::sqrt(2.0 * M_PI * (1.0 - z_min) / count);
+    for (int probe = 0; probe < 2000; ++probe) {
+      Eigen::Vector3d w(normal(rng), normal(rng), normal(rng));
+      w.normalize();
+      if (w.z() < z_min) w.z() = 2.0 * z_min - w.z();  // reflected into the cap (renormalised below)
+      w.normalize();
+      if (w.z() < z_min) continue;
+      double nearest = -1.0;
+      for (const auto& v : lattice) nearest = std::max(nearest, v.dot(w));
+      EXPECT_LT(std::acos(std::min(1.0, nearest)), spacing) << z_min << " at " << w.transpose();
+    }
+  }
+}
 
 TEST(AbsPower, FiniteAtZeroAndForNegativeArguments) {
   for (double gamma : {2.0, 2.5, 3.0, 3.7, 4.0}) {
