@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "articula/core/error.hpp"
@@ -434,14 +435,14 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (std::isfinite(len) && len > 0.0) consider(dual.eval(warm_normal));
     if (have && converged && best.s > 0.0) {
       summary.termination = "warm start, separated (dual certificate)";
-    } else if (have && converged && warm_start->search.rival_count >= 0 && best.v.dot(warm_normal) > kMoved) {
+    } else if (have && converged && warm_start->search && best.v.dot(warm_normal) > kMoved) {
       // Overlap: the answer stands while what the last global search saw
       // stays below it: the dual has moved by at most `drift` since, so a
       // bound from then, plus drift, still holds. Where that is not enough,
       // a watched cap is bounded again here and a rival's Newton model is
       // asked again here; if either could beat the answer, search again.
-      const DualSearchState& previous = warm_start->search;
-      result.search = previous;
+      const DualSearchState& previous = *warm_start->search;
+      result.search = warm_start->search;
       const double drift = (dual.c - previous.offset).norm() + (supportMatrix(a) - previous.l_a).norm() +
                            (supportMatrix(b) - previous.l_b).norm();
       bool safe = previous.outside_bound + drift < best.s;
@@ -502,7 +503,8 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     // ascent gave up) are the rivals the next step follows; the caps no
     // maximum settled are summed up by their highest bounds, the first few
     // watched one by one and the rest by one bound.
-    DualSearchState& state = result.search;
+    auto search_state = std::make_shared<DualSearchState>();
+    DualSearchState& state = *search_state;
     std::sort(ends.begin(), ends.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
     state.rival_count = 0;
     bool untracked = false;  // more rivals than a warm start follows: it searches again
@@ -540,6 +542,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     state.l_a = supportMatrix(a);
     state.l_b = supportMatrix(b);
     state.offset = dual.c;
+    result.search = std::move(search_state);
     summary.termination = !converged        ? "no ascent converged; best point of the dual reported"
                           : best.s > 0.0    ? "separated (dual certificate, after sampling)"
                           : open            ? "overlap: best maximum; the ascent limit left caps unresolved"

@@ -22,6 +22,7 @@
 // steps; when every start stalls, a hill climb on the dual gives the start.
 // Signed distance (table 5.2): d = sign(n_A . d_AB) |d_AB|, > 0 apart, < 0 overlap.
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include <Eigen/Core>
@@ -79,7 +80,7 @@ struct ContactSummary {
 /// at most |delta c| + |delta L_A|_F + |delta L_B|_F since.
 struct DualSearchState {
   static constexpr int kRivals = 3, kWatched = 8;
-  int rival_count = -1;  // -1: no global search behind this result
+  int rival_count = 0;
   Eigen::Vector3d rivals[kRivals];  // (set where rival_count says)
   double rival_ceilings[kRivals] = {};
   int watch_count = 0;
@@ -98,7 +99,11 @@ struct ContactResult {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();        // unit outward normal of A at point_a
   Eigen::Vector3d canonical_a = Eigen::Vector3d::UnitX();   // u_A: warm start of the next call
   Eigen::Vector3d canonical_b = -Eigen::Vector3d::UnitX();  // u_B
-  DualSearchState search;  // ellipsoid pairs: for warm starts (ellipsoid_contact.hpp)
+  // Ellipsoid pairs: what the last global search saw, for warm starts
+  // (ellipsoid_contact.hpp); null when no search is behind this result.
+  // Shared and immutable: a warm start passes it on without a copy, and a
+  // result stays small (about 170 bytes) for callers that keep one per pair.
+  std::shared_ptr<const DualSearchState> search;
   ContactSummary summary;
 };
 
