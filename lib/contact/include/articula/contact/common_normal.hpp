@@ -102,7 +102,7 @@ struct ContactResult {
   // Ellipsoid pairs: what the last global search saw, for warm starts
   // (ellipsoid_contact.hpp); null when no search is behind this result.
   // Shared and immutable: a warm start passes it on without a copy, and a
-  // result stays small (about 170 bytes) for callers that keep one per pair.
+  // result stays small (184 bytes, not 720) for callers that keep one per pair.
   std::shared_ptr<const DualSearchState> search;
   ContactSummary summary;
 };
