@@ -101,7 +101,7 @@ Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
   // in [1, 3], and the root tau* in [-log 3, 0].
   // Reciprocals are taken of values known before the iteration, so that the
   // divisions stay off the chain of dependent operations that sets the latency.
-  double a[3], p[3], inverse_r[3], term[3];
+  double a[3], p[3], inverse_r[3], log_r[3], term[3];
   int largest = 0;
   for (int i = 0; i < 3; ++i) {
     a[i] = std::fabs(w[i]) * (1.0 / s.exponents[i]);
@@ -113,7 +113,7 @@ Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
     // r below 1e-300 is taken as 1e-300 in 1 / r (which would overflow): the
     // u_i it scales is then at most (1e-300)^(p_i - 1), zero to u's precision.
     inverse_r[i] = a[largest] / std::max(a[i], 1e-300 * a[largest]);
-    term[i] = i == largest ? 1.0 : std::exp(p[i] * std::log(a[i] * inverse_largest));  // r^p; r = 0 gives 0
+    log_r[i] = i == largest ? 0.0 : std::log(a[i] * inverse_largest);  // r = 0 gives -inf: a zero term
   }
   // Halley's method on f(tau) = log S: f' is the mean of the p_i weighted by
   // the terms, f'' their variance (<= 1/4), |f'''| < 0.1, so a step of size h
@@ -121,17 +121,28 @@ Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
   // after a step under 1e-5 the error is below 4e-17, and the iteration stops.
   // With f' = S'/S and f'' = S''/S - f'^2, Halley's step 2 f f' / (2 f'^2 - f f'')
   // is 2 f S S' / ((2 + f) S'^2 - f S S''): one division per step; plain
-  // Newton if that denominator is not positive. tau itself is never formed:
-  // each step multiplies the terms by e^(-p_i h) and `inverse_scale` (e^-tau)
-  // by e^h, polynomials once h is small (expOfStep).
-  double inverse_scale = 1.0;
-  for (int iteration = 0; iteration < 60; ++iteration) {
-    const double S = term[0] + term[1] + term[2];
-    const double dS = p[0] * term[0] + p[1] * term[1] + p[2] * term[2];
-    const double d2S = p[0] * p[0] * term[0] + p[1] * p[1] * term[1] + p[2] * p[2] * term[2];
-    const double f = logNearOne(S);
+  // Newton if that denominator is not positive.
+  auto halleyStep = [&p](const double* t, double f) {
+    const double S = t[0] + t[1] + t[2];
+    const double dS = p[0] * t[0] + p[1] * t[1] + p[2] * t[2];
+    const double d2S = p[0] * p[0] * t[0] + p[1] * p[1] * t[1] + p[2] * p[2] * t[2];
     const double denominator = (2.0 + f) * dS * dS - f * S * d2S;
-    const double step = denominator > 0.0 ? 2.0 * f * S * dS / denominator : f * S / dS;
+    return denominator > 0.0 ? 2.0 * f * S * dS / denominator : f * S / dS;
+  };
+  // The first step, from tau = 0, is taken in single precision (expf and
+  // logf, about 1e-7 relative, cost a fraction of the double calls): it only
+  // places the start, where the terms are then computed in double, and the
+  // steps below take out its error with the rest.
+  double first_terms[3];
+  for (int i = 0; i < 3; ++i) first_terms[i] = std::exp(static_cast<float>(p[i] * log_r[i]));
+  const double first_step =
+      halleyStep(first_terms, std::log(static_cast<float>(first_terms[0] + first_terms[1] + first_terms[2])));
+  for (int i = 0; i < 3; ++i) term[i] = std::exp(p[i] * (log_r[i] - first_step));  // r^p e^(p tau)
+  // tau itself is never formed: each step multiplies the terms by e^(-p_i h)
+  // and `inverse_scale` (e^-tau) by e^h, polynomials once h is small (expOfStep).
+  double inverse_scale = std::exp(first_step);
+  for (int iteration = 0; iteration < 60; ++iteration) {
+    const double step = halleyStep(term, logNearOne(term[0] + term[1] + term[2]));
     const double bound = 2.0 * std::fabs(step);  // >= |p_i step|
     for (int i = 0; i < 3; ++i) term[i] *= expOfStep(-p[i] * step, bound);
     inverse_scale *= expOfStep(step, bound);
