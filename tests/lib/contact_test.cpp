@@ -60,6 +60,41 @@ TEST(ConvexShape, MatchesGeometryModule) {
   }
 }
 
+
+TEST(ConvexShape, EvaluationFromANearbyPointMatchesTheDirectOne) {
+  // The powers |u_i|^(g_i - 2) updated by series from a nearby point (ratios
+  // within 1e-3 of 1), chained as a Newton solve chains them, or taken afresh
+  // (farther, a zero coordinate, a sign change) agree with the direct evaluation to rounding.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> relative(-2e-3, 2e-3);
+  for (double g_max : {2.0, 4.0, 12.0}) {
+    const ConvexShape s = randomShape(rng, 0.5, 2.0, g_max);
+    for (int i = 0; i < 50; ++i) {
+      Vector3d u(g(rng), g(rng), g(rng));
+      if (i % 10 == 0) u[i % 3] = 0.0;
+      CanonicalEvaluation chained = evaluateCanonical(s, u);
+      for (int step = 0; step < 4; ++step) {
+        Vector3d next = u;
+        for (int k = 0; k < 3; ++k) next[k] *= 1.0 + relative(rng) * (step < 2 ? 1.0 : 1e-3);
+        if (i % 10 == 5 && step == 1) next[1] = -next[1];
+        chained = evaluateCanonical(s, next, u, chained);
+        const auto direct = evaluateCanonical(s, next);
+        EXPECT_NEAR(chained.value, direct.value, 4e-15 * (1 + std::fabs(direct.value)));
+        for (int k = 0; k < 3; ++k) {
+          // A few ulps for the chain, plus the direct evaluation's own error:
+          // its log's rounding times (g/2 - 1).
+          const double amplified = std::fabs((0.5 * s.exponents[k] - 1.0) * std::log(next[k] * next[k]));
+          EXPECT_NEAR(chained.powers[k], direct.powers[k],
+                      (2e-15 + 4.4e-16 * (std::isfinite(amplified) ? amplified : 0.0)) * direct.powers[k])
+              << "g " << s.exponents[k] << " u " << next[k];
+        }
+        EXPECT_LT((chained.gradient - direct.gradient).norm(), 4e-15 * direct.gradient.norm() + 1e-300);
+        u = next;
+      }
+    }
+  }
+}
 TEST(ConvexShape, SupportPointHasTheGivenNormal) {
   std::mt19937_64 rng(2);
   std::normal_distribution<double> g;

@@ -52,15 +52,18 @@ std::string ContactSummary::briefReport() const {
 namespace {
 
 struct PointData {
+  Vector3d u;         // canonical point
   Vector3d x;         // global point
   Vector3d n;         // unit outward normal
   double normal_len;  // |global gradient|
   CanonicalEvaluation e;
 };
 
-PointData pointData(const ConvexShape& s, const Vector3d& u) {
+// `near`: the last iterate's data, whose powers a nearby point updates by series.
+PointData pointData(const ConvexShape& s, const Vector3d& u, const PointData* near = nullptr) {
   PointData p;
-  p.e = evaluateCanonical(s, u);
+  p.u = u;
+  p.e = near ? evaluateCanonical(s, u, near->u, near->e) : evaluateCanonical(s, u);
   p.x = toGlobal(s, u);
   const Vector3d g = s.rotation * p.e.gradient.cwiseQuotient(s.radii);  // A g_l, A = R D^-1
   p.normal_len = g.norm();
@@ -88,9 +91,10 @@ struct SystemPoint {
 };
 
 void residual(const ConvexShape& a, const ConvexShape& b, const Vector3d& u_a, const Vector3d& u_b,
-              geometry::FrameMethod frame, double inv_l, SystemPoint& p, Vector6d& phi) {
-  p.pa = pointData(a, u_a);
-  p.pb = pointData(b, u_b);
+              geometry::FrameMethod frame, double inv_l, SystemPoint& p, Vector6d& phi,
+              const SystemPoint* near = nullptr) {
+  p.pa = pointData(a, u_a, near ? &near->pa : nullptr);
+  p.pb = pointData(b, u_b, near ? &near->pb : nullptr);
   p.f = frameWithDerivatives(p.pb.n, frame);
   p.d = p.pb.x - p.pa.x;
   phi << p.pa.n.dot(p.f.t), p.pa.n.dot(p.f.b), p.d.dot(p.f.t) * inv_l, p.d.dot(p.f.b) * inv_l, p.pa.e.value,
@@ -237,18 +241,22 @@ struct Solver {
     Vector6d q, phi, trial_phi, delta;
     q << u_a, u_b;
     Matrix6d J;
-    SystemPoint point, trial_point;
-    residual(a, b, q.head<3>(), q.tail<3>(), options.frame, inv_l, point, phi);
+    // The current point and a trial one; accepting a trial swaps the roles
+    // by pointer (std::swap of the points themselves copied hundreds of bytes three times).
+    SystemPoint points[2];
+    SystemPoint* point = &points[0];
+    SystemPoint* trial_point = &points[1];
+    residual(a, b, q.head<3>(), q.tail<3>(), options.frame, inv_l, *point, phi);
     if (!phi.allFinite()) return false;
     bool have_jacobian = false;
     auto needJacobian = [&] {
-      if (!have_jacobian) jacobian(a, b, point, inv_l, J);
+      if (!have_jacobian) jacobian(a, b, *point, inv_l, J);
       have_jacobian = true;
       return J.allFinite();
     };
     // A trial point replaces the current one when it lowers the merit enough.
     auto tryPoint = [&](const Vector6d& trial, double required) {
-      residual(a, b, trial.head<3>(), trial.tail<3>(), options.frame, inv_l, trial_point, trial_phi);
+      residual(a, b, trial.head<3>(), trial.tail<3>(), options.frame, inv_l, *trial_point, trial_phi, point);
       const double trial_merit = trial_phi.squaredNorm();
       if (!(trial_phi.allFinite() && trial_merit <= required)) return false;
       q = trial;
@@ -306,9 +314,9 @@ struct Solver {
     }
     if (!converged && std::sqrt(merit) <= 1e-11) converged = true;  // iteration cap at rounding level
     if (!converged) return false;
-    const PointData& pa = point.pa;
-    if (pa.n.dot(point.pb.n) > -0.5) return false;  // parallel normals, same sense: not a contact pair
-    const double signed_distance = std::copysign(point.d.norm(), pa.n.dot(point.d));
+    const PointData& pa = point->pa;
+    if (pa.n.dot(point->pb.n) > -0.5) return false;  // parallel normals, same sense: not a contact pair
+    const double signed_distance = std::copysign(point->d.norm(), pa.n.dot(point->d));
     if (distance) *distance = signed_distance;
     if (!have || signed_distance > best) {
       have = true;

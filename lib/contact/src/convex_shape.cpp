@@ -51,24 +51,10 @@ ConvexShape shapeFromParameters(const geometry::ShapeParameters& p) {
   }
 }
 
-CanonicalEvaluation evaluateCanonical(const ConvexShape& s, const Vector3d& u) {
-  if (s.quadric) return {u.squaredNorm() - 1.0, 2.0 * u, Vector3d::Constant(2.0)};
-  // As geometry::absPower, with |u|^(g-2) as exp((g/2 - 1) log u^2): cheaper
-  // than pow here (the solver's main cost), and exact for g = 2.
-  CanonicalEvaluation e{-1.0, Vector3d::Zero(), Vector3d::Zero()};
-  for (int i = 0; i < 3; ++i) {
-    const double g = s.exponents[i], u2 = u[i] * u[i];
-    const double p = g == 2.0 ? 1.0 : u2 > 0.0 ? std::exp((0.5 * g - 1.0) * std::log(u2)) : 0.0;  // |u|^(g-2)
-    e.value += u2 * p;
-    e.gradient[i] = g * u[i] * p;
-    e.hessian_diagonal[i] = g * (g - 1.0) * p;
-  }
-  return e;
-}
-
 namespace {
 
-// e^x for a Halley step's factor: the library call on the first, large step;
+// e^x for a small multiplicative update (a Halley step's factor below, a
+// power's change between nearby points): the library call when |x| is large;
 // a Taylor polynomial once |x| is small (error below |x|^5 / 5! < 3e-20 for
 // |x| <= 3e-4, |x|^9 / 9! < 6e-20 for |x| <= 0.03), which takes the call off
 // the iteration's critical path. `bound` >= |x| picks the branch for all
@@ -79,16 +65,55 @@ double expOfStep(double x, double bound) {
   return 1.0 + x * (1.0 + x * (1.0 / 2 + x * (1.0 / 6 + x * (1.0 / 24 + x * (1.0 / 120 + x * (1.0 / 720 + x * (1.0 / 5040 + x / 40320)))))));
 }
 
-// log S near the root, where S - 1 is small, by the series of log(1 + x)
-// (error below |x|^7 / 7 < 2e-22 for |x| <= 1e-3); else std::log, whose
-// error there only perturbs a step that the next one corrects.
-double logNearOne(double S) {
-  const double x = S - 1.0;
-  if (std::fabs(x) > 1e-3) return std::log(S);
+// log(1 + x) for |x| <= 1e-3 by its series (error below |x|^7 / 7 < 2e-22).
+double log1pSeries(double x) {
   return x * (1.0 - x * (1.0 / 2 - x * (1.0 / 3 - x * (1.0 / 4 - x * (1.0 / 5 - x / 6)))));
 }
 
+// log S near the root, where S - 1 is small, by the series; else std::log,
+// whose error there only perturbs a step that the next one corrects.
+double logNearOne(double S) { return std::fabs(S - 1.0) > 1e-3 ? std::log(S) : log1pSeries(S - 1.0); }
+
+// |u|^(g-2) as exp((g/2 - 1) log u^2): cheaper than pow here (the
+// common-normal solver's main cost), and exact for g = 2.
+double powerMinusTwo(double g, double u) {
+  const double u2 = u * u;
+  return g == 2.0 ? 1.0 : u2 > 0.0 ? std::exp((0.5 * g - 1.0) * std::log(u2)) : 0.0;
+}
+
+// As geometry::absPower, from the powers |u_i|^(g_i - 2).
+CanonicalEvaluation fromPowers(const ConvexShape& s, const Vector3d& u, const Vector3d& powers) {
+  CanonicalEvaluation e{-1.0, Vector3d::Zero(), Vector3d::Zero(), powers};
+  for (int i = 0; i < 3; ++i) {
+    const double g = s.exponents[i], p = powers[i];
+    e.value += u[i] * u[i] * p;
+    e.gradient[i] = g * u[i] * p;
+    e.hessian_diagonal[i] = g * (g - 1.0) * p;
+  }
+  return e;
+}
+
 }  // namespace
+
+CanonicalEvaluation evaluateCanonical(const ConvexShape& s, const Vector3d& u) {
+  if (s.quadric) return {u.squaredNorm() - 1.0, 2.0 * u, Vector3d::Constant(2.0), Vector3d::Ones()};
+  Vector3d powers;
+  for (int i = 0; i < 3; ++i) powers[i] = powerMinusTwo(s.exponents[i], u[i]);
+  return fromPowers(s, u, powers);
+}
+
+CanonicalEvaluation evaluateCanonical(const ConvexShape& s, const Vector3d& u, const Vector3d& u_near,
+                                      const CanonicalEvaluation& near) {
+  if (s.quadric) return evaluateCanonical(s, u);
+  Vector3d powers;
+  for (int i = 0; i < 3; ++i) {
+    const double ratio = (u[i] - u_near[i]) / u_near[i];  // u / u_near - 1: not finite when u_near = 0
+    const double y = (s.exponents[i] - 2.0) * log1pSeries(ratio);
+    powers[i] = std::fabs(ratio) <= 1e-3 ? near.powers[i] * expOfStep(y, std::fabs(y))
+                                         : powerMinusTwo(s.exponents[i], u[i]);
+  }
+  return fromPowers(s, u, powers);
+}
 
 Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
   // max w . u subject to F(u) = 0, with w = D R^T v (v . x = w . u + v . c).
