@@ -60,7 +60,6 @@ TEST(ConvexShape, MatchesGeometryModule) {
   }
 }
 
-
 TEST(ConvexShape, EvaluationFromANearbyPointMatchesTheDirectOne) {
   // The powers |u_i|^(g_i - 2) updated by series from a nearby point (ratios
   // within 1e-3 of 1), chained as a Newton solve chains them, or taken afresh
@@ -95,6 +94,7 @@ TEST(ConvexShape, EvaluationFromANearbyPointMatchesTheDirectOne) {
     }
   }
 }
+
 TEST(ConvexShape, SupportPointHasTheGivenNormal) {
   std::mt19937_64 rng(2);
   std::normal_distribution<double> g;
