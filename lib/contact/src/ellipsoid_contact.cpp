@@ -121,6 +121,7 @@ Symmetric3 shapeMatrix(const ConvexShape& shape) {
 struct DualPoint {
   Vector3d v, xa, xb, g;
   double ha, hb, s;
+  double inverse_ha, inverse_hb;  // 1 / h_A(v), 1 / h_B(v)
 };
 
 // An upper bound of s on the cap of radius rho around a unit w, from
@@ -218,16 +219,25 @@ struct Dual {
     }
   }
 
-  DualPoint eval(const Vector3d& v) const {
+  // The dual at the direction of w (any non-zero length). The support points
+  // and the gradient are 0-homogeneous, so they are computed from w itself:
+  // normalising w first would put a square root and a division on the
+  // iteration's chain of dependent operations (the latency of a Newton step).
+  DualPoint eval(const Vector3d& w) const {
     DualPoint p;
-    p.v = v;
-    const Vector3d mav = ma * v, mbv = mb * v;
-    p.ha = std::sqrt(v.dot(mav));
-    p.hb = std::sqrt(v.dot(mbv));
-    p.xa = mav / p.ha;
-    p.xb = mbv / p.hb;
+    const double norm = std::sqrt(w.squaredNorm()), inverse_norm = 1.0 / norm;
+    p.v = w * inverse_norm;
+    const Vector3d maw = ma * w, mbw = mb * w;
+    const double ha = std::sqrt(w.dot(maw)), hb = std::sqrt(w.dot(mbw));  // h(w) = |w| h(v)
+    const double inverse_ha = 1.0 / ha, inverse_hb = 1.0 / hb;
+    p.xa = maw * inverse_ha;
+    p.xb = mbw * inverse_hb;
     p.g = c - p.xa - p.xb;
-    p.s = v.dot(c) - p.ha - p.hb;
+    p.ha = ha * inverse_norm;
+    p.hb = hb * inverse_norm;
+    p.inverse_ha = inverse_ha * norm;
+    p.inverse_hb = inverse_hb * norm;
+    p.s = p.v.dot(c) - p.ha - p.hb;
     return p;
   }
 
@@ -248,7 +258,7 @@ struct Dual {
   };
   Step newtonStep(const DualPoint& p) const {
     const Vector3d r = p.g - p.g.dot(p.v) * p.v;
-    const double ia = 1.0 / p.ha, ib = 1.0 / p.hb;
+    const double ia = p.inverse_ha, ib = p.inverse_hb;
     Symmetric3 k{-(ma.xx * ia + mb.xx * ib) - p.s, -(ma.yy * ia + mb.yy * ib) - p.s, -(ma.zz * ia + mb.zz * ib) - p.s,
                  -(ma.xy * ia + mb.xy * ib),       -(ma.xz * ia + mb.xz * ib),       -(ma.yz * ia + mb.yz * ib)};
     k.addOuter(ia, p.xa);
@@ -265,12 +275,10 @@ struct Dual {
       k.xx -= shift, k.yy -= shift, k.zz -= shift;
       k.addOuter(shift, p.v);
     }
-    Vector3d d = -k.solve(r);
-    d -= d.dot(p.v) * p.v;  // tangent to rounding
+    const Vector3d d = -k.solve(r);  // tangent: v is an eigenvector of K
     const double gain = definite ? 0.5 * r.dot(d) : NAN;
     const double norm = d.norm();
-    if (norm > 0.5) d *= 0.5 / norm;  // at most about 0.5 rad at once
-    return {d, r.squaredNorm(), gain};
+    return {norm > 0.5 ? Vector3d(d * (0.5 / norm)) : d, r.squaredNorm(), gain};  // at most about 0.5 rad at once
   }
 
   double gradient2(const DualPoint& p) const { return (p.g - p.g.dot(p.v) * p.v).squaredNorm(); }
@@ -304,7 +312,7 @@ struct Dual {
       bool accepted = false;
       const double rounding = 1e-15 * (std::fabs(p.s) + p.ha + p.hb);
       for (double alpha = 1.0; alpha >= 1.0 / 64.0; alpha *= 0.5) {
-        const DualPoint q = eval((p.v + alpha * step.d).normalized());
+        const DualPoint q = eval(p.v + alpha * step.d);
         if (q.s >= p.s - rounding) {
           p = q;
           accepted = true;
@@ -555,8 +563,8 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
   result.distance = best.s;
   result.point_a = a.center + best.xa;
   result.point_b = b.center - best.xb;
-  result.canonical_a = a.radii.cwiseProduct(a.rotation.transpose() * v) / best.ha;
-  result.canonical_b = -b.radii.cwiseProduct(b.rotation.transpose() * v) / best.hb;
+  result.canonical_a = a.radii.cwiseProduct(a.rotation.transpose() * v) * best.inverse_ha;
+  result.canonical_b = -b.radii.cwiseProduct(b.rotation.transpose() * v) * best.inverse_hb;
   summary.certified = converged && best.s > 0.0;
   summary.residual = (best.g - best.s * v).norm() / dual.length;
   return result;
