@@ -274,7 +274,7 @@ class ContactCommand : public cli::Command {
                               {"invalid_rows", invalid},
                               {"plane_rows", planes},
                               {"converged", converged},
-                              {"certified_separated", certified},
+                              {"certified_global", certified},
                               {"mean_iterations", static_cast<double>(iterations) / valid},
                               {"ns_per_query", median(ns)},
                               {"ns_per_query_note", "median over valid rows of the fastest of 5 identical calls; solver only, no file I/O"}};

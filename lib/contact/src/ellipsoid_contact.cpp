@@ -144,6 +144,9 @@ struct Dual {
   double length;
   // (r_min r_mid)^2 and r_max of each: the support function's curvature is at least the first over |L v|^3.
   double curvature_a, max_radius_a, curvature_b, max_radius_b;
+  // r_min^2 / r_max of A plus that of B: the least radius of curvature of
+  // each ellipsoid, so along every great circle s'' + s <= -curvature_floor.
+  double curvature_floor;
   double gradient_tolerance;
 
   Dual(const ConvexShape& a, const ConvexShape& b)
@@ -154,8 +157,21 @@ struct Dual {
     const double mid_min_a = a.radii.prod() / max_radius_a, mid_min_b = b.radii.prod() / max_radius_b;
     curvature_a = mid_min_a * mid_min_a;
     curvature_b = mid_min_b * mid_min_b;
+    const double min_radius_a = a.radii.minCoeff(), min_radius_b = b.radii.minCoeff();
+    curvature_floor = min_radius_a * min_radius_a / max_radius_a + min_radius_b * min_radius_b / max_radius_b;
     gradient_tolerance = kGradientTolerance * length;
   }
+
+  // Whether a stationary point of value s is the global maximum by the
+  // curvature certificate: with k = curvature_floor, along every great
+  // circle from the stationary point s'' <= -s - k and s' = 0 there, so
+  // (Sturm comparison) s(phi) <= (s + k) cos phi - k, below s everywhere
+  // else once s + k > 0. (Geometrically: the Minkowski difference A - B is a
+  // convex body plus a ball of radius k, and an overlap shallower than k has
+  // one nearest boundary point.) The margin keeps what a gradient G at the
+  // tolerance could add elsewhere, G^2 / (2 (s + k)), at rounding level.
+  // s > 0 (separated) is the case k = 0: concavity.
+  bool certifiedByCurvature(double s) const { return s + curvature_floor > 1e-4 * length; }
 
   // A lower bound of the curvature k_A + k_B of the support functions on the
   // cap of radius rho around a unit w with h_A(w) = ha, h_B(w) = hb:
@@ -443,6 +459,9 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (std::isfinite(len) && len > 0.0) consider(dual.eval(warm_normal));
     if (have && converged && best.s > 0.0) {
       summary.termination = "warm start, separated (dual certificate)";
+    } else if (have && converged && options.curvature_certificate && dual.certifiedByCurvature(best.s)) {
+      summary.termination = "warm start, overlap within the curvature bound (curvature certificate)";
+      result.search = warm_start->search;  // for a later step that goes deeper
     } else if (have && converged && warm_start->search && best.v.dot(warm_normal) > kMoved) {
       // Overlap: the answer stands while what the last global search saw
       // stays below it: the dual has moved by at most `drift` since, so a
@@ -471,6 +490,12 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (p0.s > 0.0) {  // separated for sure: the concave ascent ends at the global maximum
       consider(p0);
       if (converged && best.s > 0.0) summary.termination = "separated (dual certificate)";
+    } else if (options.curvature_certificate && dual.certifiedByCurvature(p0.s)) {
+      // The ascent only climbs, so it ends at a stationary point above -k:
+      // the global maximum by the curvature certificate, without sampling.
+      consider(p0);
+      if (converged && dual.certifiedByCurvature(best.s))
+        summary.termination = "overlap within the curvature bound (curvature certificate)";
     }
   }
 
@@ -565,7 +590,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
   result.point_b = b.center - best.xb;
   result.canonical_a = a.radii.cwiseProduct(a.rotation.transpose() * v) * best.inverse_ha;
   result.canonical_b = -b.radii.cwiseProduct(b.rotation.transpose() * v) * best.inverse_hb;
-  summary.certified = converged && best.s > 0.0;
+  summary.certified = converged && (best.s > 0.0 || dual.certifiedByCurvature(best.s));
   summary.residual = (best.g - best.s * v).norm() / dual.length;
   return result;
 }

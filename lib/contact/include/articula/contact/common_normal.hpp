@@ -47,12 +47,16 @@ struct ContactOptions {
   int sample_directions = 64;       // dual samples for the global search (overlap)
   int global_starts = 3;            // common-normal system: Newton starts from the best distinct samples
   bool verify_warm_overlap = false;  // warm start and overlap: also run the global search
+  // Ellipsoid pairs: an overlap shallower than the bodies' least radii of
+  // curvature is certified without the global search (ellipsoid_contact.hpp);
+  // false searches anyway (to check the certificate).
+  bool curvature_certificate = true;
   /// Throws UsageError naming the first bad field.
   void validate() const;
 };
 
 enum class ContactStatus {
-  Converged,     // Newton converged; separated answers are certified global
+  Converged,     // Newton converged; separated answers (and shallow ellipsoid overlaps) are certified global
   NotConverged,  // no Newton start converged: the answer is the dual hill climb's
 };
 const char* statusName(ContactStatus status);  // "converged", "not_converged"
@@ -65,7 +69,8 @@ struct ContactSummary {
   int damped_steps = 0;      // Levenberg-Marquardt steps (singular Jacobian or rejected Newton step)
   bool warm_started = false;
   bool global_search = false;  // the dual was sampled
-  bool certified = false;      // separated: global minimum by concavity of the dual
+  bool certified = false;      // the answer is proven the dual's global maximum: separated (concavity), or
+                               // two ellipsoids overlapping less than their least radii of curvature (ellipsoid_contact.hpp)
   double residual = 0.0;       // |Phi| at the answer
   std::string briefReport() const;
 };

@@ -18,8 +18,16 @@
 // tangential gradient |(I - v v^T) grad s| falls below 1e-11 of the length
 // scale; the distance error is quadratic in it.
 //
-// Cold: ascend from the centre direction when s > 0 there (separated).
-// Overlap: the dual is bounded on the cap (covering radius rho) of each of
+// Curvature certificate (overlap): along every great circle s'' + s is
+// minus the sum of the two bodies' radii of curvature there (of their
+// projections on the circle's plane), at most -k with k = r_min^2 / r_max of
+// A plus that of B. From a stationary point v*, s(phi) <= (s* + k) cos phi - k
+// (Sturm comparison), below s* everywhere else when s* > -k: an overlap
+// shallower than k has a single local maximum, the global one.
+//
+// Cold: ascend from the centre direction when s > 0 there (separated), or
+// s > -k (the ascent only climbs, so it ends above -k: certified).
+// Deeper overlap: the dual is bounded on the cap (covering radius rho) of each of
 // `sample_directions` antipodal samples: along a great circle s'' = -s - k_A
 // - k_B, with k the support functions' curvature, at least
 // (r_min r_mid)^2 / |L v|^3 (L = D R^T), so s <= (s_0 + K) cos phi + G sin phi
@@ -28,8 +36,8 @@
 // samples within 2 rho of a maximum reached are taken to lie in its basin
 // (the search's one assumption). Ascents give up early when heading for a
 // known maximum or when their Newton model cannot beat the best.
-// Warm: one ascent from the previous normal. Separated: certified as above.
-// Overlap: the answer stands while what the last global search saw, moved
+// Warm: one ascent from the previous normal. Separated or above -k: certified as above.
+// Deeper overlap: the answer stands while what the last global search saw, moved
 // since by at most |delta c| + |delta L_A|_F + |delta L_B|_F, stays below it
 // (its rivals, 8 watched caps, bounded again and split into 7 smaller caps
 // twice where needed, and one bound for the rest: DualSearchState);
