@@ -522,7 +522,13 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (converged) settle(best.v);
     const double margin = 1e-12 * dual.length;
     bool open = true;  // the ascent limit stopped the search before every cap was below the answer
+    bool curvature = false;  // a maximum reached is above -k: the rest need not be bounded
     for (int ascents = 0; ascents < kMaxAscents; ++ascents) {
+      if (converged && options.curvature_certificate && dual.certifiedByCurvature(best.s)) {
+        open = false;
+        curvature = true;
+        break;
+      }
       const int top = found.empty() ? highestAbove(s.data(), n, -INFINITY) : highestAbove(bound.data(), n, best.s + margin);
       if (top < 0) {
         open = false;
@@ -578,6 +584,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     result.search = std::move(search_state);
     summary.termination = !converged        ? "no ascent converged; best point of the dual reported"
                           : best.s > 0.0    ? "separated (dual certificate, after sampling)"
+                          : curvature       ? "overlap: a maximum reached is above -k (curvature certificate)"
                           : open            ? "overlap: best maximum; the ascent limit left caps unresolved"
                                             : "overlap: no sample's cap bound beats the best maximum";
   }
