@@ -464,13 +464,13 @@ TEST(Contact, ShallowEllipsoidOverlapsAreCertifiedByCurvature) {
   // single maximum of the dual (ellipsoid_contact.hpp): certified without
   // sampling. The analytic case: a sphere of radius 1 against the side of an
   // ellipsoid (1, 2, 3) (k = 4/3), 0.5 deep.
-  const ConvexShape a = makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 2, 3));
-  const ConvexShape b = makeConvexShape(Vector3d(1.5, 0, 0), Matrix3d::Identity(), Vector3d(1, 1, 1));
-  const ContactResult r = computeContact(a, b);
-  EXPECT_NEAR(r.distance, -0.5, 1e-12);
-  EXPECT_TRUE(r.summary.certified);
-  EXPECT_FALSE(r.summary.global_search);
-  EXPECT_EQ(r.search, nullptr);
+  const ConvexShape ellipsoid = makeConvexShape(Vector3d::Zero(), Matrix3d::Identity(), Vector3d(1, 2, 3));
+  const ConvexShape sphere = makeConvexShape(Vector3d(1.5, 0, 0), Matrix3d::Identity(), Vector3d(1, 1, 1));
+  const ContactResult analytic = computeContact(ellipsoid, sphere);
+  EXPECT_NEAR(analytic.distance, -0.5, 1e-12);
+  EXPECT_TRUE(analytic.summary.certified);
+  EXPECT_FALSE(analytic.summary.global_search);
+  EXPECT_EQ(analytic.search, nullptr);
   // Random pairs, aspect up to 10, from just apart to twice k deep, cold and
   // warm, against the sampled search with the certificate switched off. A
   // certificate taken too far (k overestimated) keeps a local maximum that
@@ -498,7 +498,9 @@ TEST(Contact, ShallowEllipsoidOverlapsAreCertifiedByCurvature) {
         ADD_FAILURE() << "pair " << i << (r == &cold ? " cold: " : " warm: ") << r->distance << " against "
                       << expected << " (k " << k << "), " << r->summary.briefReport();
       const double length = std::max(a.radii.maxCoeff(), b.radii.maxCoeff());
-      if (r->distance < 0.0) EXPECT_EQ(r->summary.certified, r->distance > 1e-4 * length - k) << "pair " << i;
+      if (r->distance < 0.0) {
+        EXPECT_EQ(r->summary.certified, r->distance > 1e-4 * length - k) << "pair " << i;
+      }
     }
   }
   EXPECT_EQ(misses, 0);
