@@ -283,6 +283,15 @@ void placeAt(ConvexShape& a, ConvexShape& b, std::mt19937_64& rng, double target
   b.center = a.center + dir * (ea + eb + target);
 }
 
+// b one motion step earlier: `step` mm away and turned by `step` rad, both
+// along random directions (drawn with g on rng), as the bench's warm starts.
+ConvexShape stepBack(const ConvexShape& b, std::mt19937_64& rng, std::normal_distribution<double>& g, double step) {
+  ConvexShape before = b;
+  before.center += step * Vector3d(g(rng), g(rng), g(rng)).normalized();
+  before.rotation = Eigen::AngleAxisd(step, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+  return before;
+}
+
 struct PairClass {
   const char* name;
   double gap_min, gap_max;
@@ -366,9 +375,7 @@ TEST(Contact, SuperellipsoidPairsAgainstReference) {
       ConvexShape a = randomShape(rng, 0.5, 1.5, 4.0), b = randomShape(rng, 0.5, 1.5, 4.0);
       placeAt(a, b, rng, gap(rng));
       const double ref = referenceConvexDistance(a, b, 1500, 4);
-      ConvexShape before = b;
-      before.center += 0.01 * Vector3d(g(rng), g(rng), g(rng)).normalized();
-      before.rotation = Eigen::AngleAxisd(0.01, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+      const ConvexShape before = stepBack(b, rng, g, 0.01);
       const ContactResult previous = computeContact(a, before);
       const ContactResult cold = computeContact(a, b), warm = computeContact(a, b, {}, &previous);
       EXPECT_EQ(cold.summary.status, ContactStatus::Converged) << c.name << " " << cold.summary.briefReport();
@@ -486,9 +493,7 @@ TEST(Contact, ShallowEllipsoidOverlapsAreCertifiedByCurvature) {
     const double k = std::pow(a.radii.minCoeff(), 2) / a.radii.maxCoeff() +
                      std::pow(b.radii.minCoeff(), 2) / b.radii.maxCoeff();
     placeAt(a, b, rng, fraction(rng) * k);
-    ConvexShape before = b;
-    before.center += 0.01 * Vector3d(g(rng), g(rng), g(rng)).normalized();
-    before.rotation = Eigen::AngleAxisd(0.01, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+    const ConvexShape before = stepBack(b, rng, g, 0.01);
     const double expected = computeContact(a, b, searched).distance;
     const ContactResult previous = computeContact(a, before);
     const ContactResult cold = computeContact(a, b), warm = computeContact(a, b, {}, &previous);
@@ -516,9 +521,7 @@ TEST(Contact, WarmStartsOnDeepOverlapsFindTheGlobalAnswer) {
   for (int i = 0; i < 60; ++i) {
     ConvexShape a = randomShape(rng, 0.15, 1.5), b = randomShape(rng, 0.15, 1.5);
     placeAt(a, b, rng, gap(rng));
-    ConvexShape before = b;
-    before.center += 0.02 * Vector3d(g(rng), g(rng), g(rng)).normalized();
-    before.rotation = Eigen::AngleAxisd(0.02, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+    const ConvexShape before = stepBack(b, rng, g, 0.02);
     const ContactResult previous = computeContact(a, before);
     const ContactResult warm = computeContact(a, b, {}, &previous);
     EXPECT_NEAR(warm.distance, referenceDistance(a, b), 1e-10) << "pair " << i << ": " << warm.summary.briefReport();
@@ -550,9 +553,7 @@ TEST(Contact, ElongatedDeepOverlapsAgainstADenseSearch) {
     const Vector3d dir = Vector3d(g(rng), g(rng), g(rng)).normalized();
     const double reach = dir.dot(toGlobal(a, supportCanonical(a, dir))) - dir.dot(toGlobal(b, supportCanonical(b, -dir)));
     b.center = dir * (reach * along(rng) + depth(rng));
-    ConvexShape before = b;
-    before.center += 0.02 * Vector3d(g(rng), g(rng), g(rng)).normalized();
-    before.rotation = Eigen::AngleAxisd(0.02, Vector3d(g(rng), g(rng), g(rng)).normalized()) * before.rotation;
+    const ConvexShape before = stepBack(b, rng, g, 0.02);
     const double expected = computeContact(a, b, dense).distance;
     const ContactResult previous = computeContact(a, before);
     const ContactResult cold = computeContact(a, b), warm = computeContact(a, b, {}, &previous);
