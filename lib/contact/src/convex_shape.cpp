@@ -159,7 +159,7 @@ Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
   // places the start, where the terms are then computed in double, and the
   // steps below take out its error with the rest.
   double first_terms[3];
-  for (int i = 0; i < 3; ++i) first_terms[i] = std::exp(static_cast<float>(p[i] * log_r[i]));
+  for (int i = 0; i < 3; ++i) first_terms[i] = i == largest ? 1.0 : std::exp(static_cast<float>(p[i] * log_r[i]));
   const double first_step =
       halleyStep(first_terms, std::log(static_cast<float>(first_terms[0] + first_terms[1] + first_terms[2])));
   for (int i = 0; i < 3; ++i) term[i] = std::exp(p[i] * (log_r[i] - first_step));  // r^p e^(p tau)
