@@ -241,7 +241,7 @@ struct Dual {
   // iteration's chain of dependent operations (the latency of a Newton step).
   DualPoint eval(const Vector3d& w) const {
     DualPoint p;
-    const double norm = std::sqrt(w.squaredNorm()), inverse_norm = 1.0 / norm;
+    const double norm = w.norm(), inverse_norm = 1.0 / norm;
     p.v = w * inverse_norm;
     const Vector3d maw = ma * w, mbw = mb * w;
     const double ha = std::sqrt(w.dot(maw)), hb = std::sqrt(w.dot(mbw));  // h(w) = |w| h(v)
@@ -428,6 +428,8 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
   if (!a.quadric || !b.quadric) throw UsageError("ellipsoidContact: both shapes must be ellipsoids (exponents 2)");
   options.validate();
   const Dual dual(a, b);
+  // Whether the curvature certificate may stop a search (the option turns it off to check it).
+  const auto stopsByCurvature = [&](double s) { return options.curvature_certificate && dual.certifiedByCurvature(s); };
   ContactResult result;
   ContactSummary& summary = result.summary;
 
@@ -459,7 +461,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (std::isfinite(len) && len > 0.0) consider(dual.eval(warm_normal));
     if (have && converged && best.s > 0.0) {
       summary.termination = "warm start, separated (dual certificate)";
-    } else if (have && converged && options.curvature_certificate && dual.certifiedByCurvature(best.s)) {
+    } else if (have && converged && stopsByCurvature(best.s)) {
       summary.termination = "warm start, overlap within the curvature bound (curvature certificate)";
       result.search = warm_start->search;  // for a later step that goes deeper
     } else if (have && converged && warm_start->search && best.v.dot(warm_normal) > kMoved) {
@@ -490,7 +492,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     if (p0.s > 0.0) {  // separated for sure: the concave ascent ends at the global maximum
       consider(p0);
       if (converged && best.s > 0.0) summary.termination = "separated (dual certificate)";
-    } else if (options.curvature_certificate && dual.certifiedByCurvature(p0.s)) {
+    } else if (stopsByCurvature(p0.s)) {
       // The ascent only climbs, so it ends at a stationary point above -k:
       // the global maximum by the curvature certificate, without sampling.
       consider(p0);
@@ -524,7 +526,7 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     bool open = true;  // the ascent limit stopped the search before every cap was below the answer
     bool curvature = false;  // a maximum reached is above -k: the rest need not be bounded
     for (int ascents = 0; ascents < kMaxAscents; ++ascents) {
-      if (converged && options.curvature_certificate && dual.certifiedByCurvature(best.s)) {
+      if (converged && stopsByCurvature(best.s)) {
         open = false;
         curvature = true;
         break;
