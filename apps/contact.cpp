@@ -6,6 +6,7 @@
 // Output: a CSV (LPS mm) and FILE.json with the summary and provenance;
 // --json prints the summary (with the median solver time per query).
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -56,10 +57,14 @@ struct BadRow : std::runtime_error {
 struct Row {
   const std::map<std::string, size_t>& columns;
   const std::vector<std::string>& cells;
-  double number(const std::string& name) const {
+  const std::string& text(const std::string& name) const {
     const auto it = columns.find(name);
     if (it == columns.end()) throw BadRow("column '" + name + "' is missing from the header");
-    const std::string& text = cells[it->second];
+    return cells[it->second];
+  }
+  bool empty(const std::string& name) const { return columns.count(name) == 0 || cells[columns.at(name)].empty(); }
+  double number(const std::string& name) const {
+    const std::string& text = this->text(name);
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     if (text.empty() || end != text.c_str() + text.size()) throw BadRow(name + ": expected a number, found '" + text + "'");
@@ -72,7 +77,9 @@ struct Row {
 };
 
 // Shape "a" or "b" of a row; warns when the quaternion had to be normalised.
-ConvexShape rowShape(const Row& r, const std::string& s, int line) {
+// `kind` (shape_b): "sphere" and "ellipsoid" take empty exponent cells as 2
+// and reject others; "sphere" also needs three equal radii.
+ConvexShape rowShape(const Row& r, const std::string& s, int line, const std::string& kind = "") {
   const Eigen::Vector4d q(r.number("qw_" + s), r.number("qx_" + s), r.number("qy_" + s), r.number("qz_" + s));
   const double len = q.norm();
   if (!(len > 1e-12)) throw BadRow("quaternion " + s + " is zero");
@@ -80,9 +87,21 @@ ConvexShape rowShape(const Row& r, const std::string& s, int line) {
     log::warn("line " + std::to_string(line) + ": quaternion " + s + " has length " + std::to_string(len) +
               "; normalised");
   const Eigen::Matrix3d R = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+  const Vector3d radii = r.vec("ra_" + s, "rb_" + s, "rc_" + s);
+  Vector3d exponents(2.0, 2.0, 2.0);
+  const bool quadric = kind == "sphere" || kind == "ellipsoid";
+  for (int i = 0; i < 3; ++i) {
+    const std::string column = "g" + std::to_string(i + 1) + "_" + s;
+    if (quadric && r.empty(column)) continue;
+    exponents[i] = r.number(column);
+    if (quadric && exponents[i] != 2.0)
+      throw BadRow(column + ": expected 2 or an empty cell (shape_" + s + " is " + kind + "), found " + r.text(column));
+  }
+  if (kind == "sphere" && !(radii.maxCoeff() - radii.minCoeff() <= 1e-12 * radii.maxCoeff()))
+    throw BadRow("shape_" + s + " is sphere: expected ra_" + s + " = rb_" + s + " = rc_" + s + ", found " +
+                 r.text("ra_" + s) + ", " + r.text("rb_" + s) + ", " + r.text("rc_" + s));
   try {
-    return contact::makeConvexShape(r.vec("cx_" + s, "cy_" + s, "cz_" + s), R,
-                                    r.vec("ra_" + s, "rb_" + s, "rc_" + s), r.vec("g1_" + s, "g2_" + s, "g3_" + s));
+    return contact::makeConvexShape(r.vec("cx_" + s, "cy_" + s, "cz_" + s), R, radii, exponents);
   } catch (const InvalidParameter& e) {
     throw BadRow("shape " + s + ": " + e.what());
   }
@@ -168,7 +187,7 @@ class ContactCommand : public cli::Command {
                                  "CSV, one query per row: cx_a,cy_a,cz_a,qw_a,qx_a,qy_a,qz_a,ra_a,rb_a,rc_a,g1_a,g2_a,"
                                  "g3_a and the same with _b (quaternion w,x,y,z; exponents 2 = ellipsoid); optional "
                                  "column shape_b: 'plane' takes b as the plane through cx_b,cy_b,cz_b with normal "
-                                 "nx_b,ny_b,nz_b");
+                                 "nx_b,ny_b,nz_b; 'sphere' or 'ellipsoid' may leave g1_b,g2_b,g3_b empty");
     auto* scenario = app.add_option("--scenario", scenario_, "Prescribed motion: table5.3-1..4, table5.4-1..3");
     auto* fits_a = app.add_option("--fits-a", fits_a_, "fits.json of surface A (articula-fit)");
     app.add_option("--fits-b", fits_b_, "fits.json of surface B")->needs(fits_a);
@@ -238,11 +257,12 @@ class ContactCommand : public cli::Command {
           throw BadRow("expected " + std::to_string(header.size()) + " cells, found " + std::to_string(cells.size()));
         const Row row{columns, cells};
         const ConvexShape a = rowShape(row, "a", line_no);
-        const bool plane = columns.count("shape_b") && cells[columns.at("shape_b")] == "plane";
-        if (columns.count("shape_b") && !plane && !cells[columns.at("shape_b")].empty() &&
-            cells[columns.at("shape_b")] != "superellipsoid" && cells[columns.at("shape_b")] != "ellipsoid")
-          throw BadRow("shape_b: expected plane, ellipsoid, superellipsoid or empty, found '" +
-                       cells[columns.at("shape_b")] + "'");
+        std::string kind = row.empty("shape_b") ? "" : row.text("shape_b");
+        std::transform(kind.begin(), kind.end(), kind.begin(), [](unsigned char c) { return std::tolower(c); });
+        if (kind != "" && kind != "plane" && kind != "sphere" && kind != "ellipsoid" && kind != "superellipsoid")
+          throw BadRow("shape_b: expected plane, sphere, ellipsoid, superellipsoid or empty, found '" +
+                       row.text("shape_b") + "'");
+        const bool plane = kind == "plane";
         ContactResult r;
         if (plane) {
           const Vector3d p = row.vec("cx_b", "cy_b", "cz_b"), n = row.vec("nx_b", "ny_b", "nz_b");
@@ -250,7 +270,7 @@ class ContactCommand : public cli::Command {
           ns.push_back(timeNs([&] { r = contact::shapePlaneContact(a, p, n); }));
           ++planes;
         } else {
-          const ConvexShape b = rowShape(row, "b", line_no);
+          const ConvexShape b = rowShape(row, "b", line_no, kind);
           ns.push_back(timeNs([&] { r = contact::computeContact(a, b, options_); }));
         }
         writeRow(out, r);

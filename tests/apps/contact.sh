@@ -25,6 +25,24 @@ for i in "${!expected[@]}"; do
   fi
 done
 
+# shape_b kinds (case-insensitive): a sphere or an ellipsoid may leave its
+# exponents empty; a sphere with unequal radii, an ellipsoid with exponent 3,
+# an unknown kind and a superellipsoid without exponents are invalid rows.
+kinds="$ARTICULA_TMP/kinds.csv"
+{ head -1 "$ARTICULA_SOURCE/testdata/contact/pairs.csv"
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,Sphere,4,0,0,1,0,0,0,1,1,1,,,,,,'
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,ellipsoid,0,5,0,1,0,0,0,1,2,3,,,,,,'
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,sphere,4,0,0,1,0,0,0,1,2,3,,,,,,'
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,ellipsoid,4,0,0,1,0,0,0,1,1,1,3,,,,,'
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,cube,4,0,0,1,0,0,0,1,1,1,2,2,2,,,'
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,PLANE,0,0,-3,,,,,,,,,,,0,0,1'
+  echo '0,0,0,1,0,0,0,2,2,2,2,2,2,superellipsoid,4,0,0,1,0,0,0,1,1,1,,,,,,'; } > "$kinds"
+"$bin" contact --pairs "$kinds" -o "$ARTICULA_TMP/kinds_out.csv" --force 2> "$ARTICULA_TMP/kinds.err"
+awk -F, 'NR > 1 { s = s $1 ":" $12 " " } END { if (s != "1:converged 1:converged nan:invalid nan:invalid nan:invalid 1:converged nan:invalid ") { print "kinds: " s; exit 1 } }' \
+  "$ARTICULA_TMP/kinds_out.csv"
+grep -q 'kinds.csv:4: shape_b is sphere: expected ra_b = rb_b = rc_b, found 1, 2, 3' "$ARTICULA_TMP/kinds.err"
+grep -q "kinds.csv:6: shape_b: expected plane, sphere, ellipsoid, superellipsoid or empty, found 'cube'" "$ARTICULA_TMP/kinds.err"
+
 # Only bad rows: exit code 3 and no output file.
 bad="$ARTICULA_TMP/bad.csv"
 { head -1 "$ARTICULA_SOURCE/testdata/contact/pairs.csv"; sed -n '7,9p' "$ARTICULA_SOURCE/testdata/contact/pairs.csv"; } > "$bad"
