@@ -28,6 +28,14 @@ class MeshCommand : public cli::Command {
     app.add_option("--passband", options_.passband, "Windowed sinc pass band")->capture_default_str();
     app.add_option("--decimate", options_.decimate, "Fraction of triangles to remove (0 = none)")->capture_default_str();
     app.add_flag("--all-components", all_components_, "Keep every connected surface, not only the largest");
+    app.add_option("--ct", ct_,
+                   "The CT the label came from (DICOM folder or image file): vertices move along their normals onto "
+                   "its bone edge (sub-voxel; without it the surface is the label's smoothed voxel boundary)");
+    app.add_option("--series-uid", series_uid_, "With --ct: the DICOM series to read when the folder holds several");
+    app.add_option("--edge-search", snap_.search_mm,
+                   "With --ct: edge search either side of a vertex, mm (0: 1.5 voxels, at least 1.5 mm)")
+        ->check(CLI::Range(0.0, 10.0))
+        ->capture_default_str();
   }
   int run(const cli::CommonOptions& common) override {
     options_.smoothing = smoothing_ == "laplacian" ? mesh::Smoothing::Laplacian
@@ -40,26 +48,52 @@ class MeshCommand : public cli::Command {
       throw UsageError("--output: expected a .vtp, .stl or .ply file, found '" + output_.string() + "'");
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
+    snap_.validate();
     const imaging::Label label = imaging::readLabel(input_);
     mesh::MeshSummary s;
-    const mesh::TriangleMesh m = mesh::extractSurface(label, options_, &s);
+    mesh::TriangleMesh m = mesh::extractSurface(label, options_, &s);
+    nlohmann::json edges = nullptr;
+    if (!ct_.empty()) {
+      imaging::ReadOptions read;
+      read.series_uid = series_uid_;
+      const imaging::Volume ct = imaging::readVolume(ct_, read);
+      mesh::EdgeSnapSummary snapped;
+      mesh::snapToEdges(m, ct, snap_, &snapped);
+      const double share = snapped.vertices ? static_cast<double>(snapped.on_edge) / snapped.vertices : 0.0;
+      edges = {{"ct", ct_.string()},
+               {"vertices_on_edge", snapped.on_edge},
+               {"share_on_edge", share},
+               {"mean_shift_mm", snapped.mean_shift_mm},
+               {"mean_abs_shift_mm", snapped.mean_abs_shift_mm}};
+      log::info("mesh: " + std::to_string(snapped.on_edge) + " of " + std::to_string(snapped.vertices) +
+                " vertices moved onto the CT's edge (mean shift " + std::to_string(snapped.mean_shift_mm) + " mm)");
+      if (share < 0.5)
+        log::warn("mesh: only " + std::to_string(static_cast<int>(100 * share)) +
+                  " % of the vertices found a bone edge in the CT: is it the CT the label was made from?");
+    }
     mesh::writeMesh(output_, m, true);
     log::info("mesh: " + std::to_string(s.vertices) + " vertices, " + std::to_string(s.triangles) + " triangles");
     nlohmann::json params = {{"smoothing", smoothing_}, {"smooth_iterations", options_.smooth_iterations},
                              {"relaxation", options_.relaxation}, {"passband", options_.passband},
-                             {"decimate", options_.decimate}, {"largest_component", options_.largest_component}};
+                             {"decimate", options_.decimate}, {"largest_component", options_.largest_component},
+                             {"edge_search_mm", snap_.search_mm}};
     nlohmann::json summary = {{"input", input_.string()},       {"output", output_.string()},
                               {"label_voxels", s.label_voxels}, {"raw_triangles", s.raw_triangles},
                               {"triangles", s.triangles},       {"vertices", s.vertices},
-                              {"provenance", provenanceJson({params, {input_}, -1})}};
+                              {"ct_edges", edges},
+                              {"provenance", provenanceJson({params, ct_.empty() || std::filesystem::is_directory(ct_)
+                                                                          ? std::vector<std::filesystem::path>{input_}
+                                                                          : std::vector<std::filesystem::path>{input_, ct_},
+                                                                      -1})}};
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);
     if (common.json) cli::printJson(summary);
     return 0;
   }
 
  private:
-  std::filesystem::path input_, output_;
-  std::string smoothing_ = "laplacian";
+  std::filesystem::path input_, output_, ct_;
+  std::string smoothing_ = "laplacian", series_uid_;
+  mesh::EdgeSnapOptions snap_;
   bool all_components_ = false;
   mesh::MeshOptions options_;
 };

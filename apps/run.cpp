@@ -169,7 +169,10 @@ class RunCommand : public cli::Command {
     if (stage == "segment") {
       p = {{"-i", input_.string(), "-o", label.string(), "--joint", joint_, "--side", side_}, {input_}, {label}};
     } else if (stage == "mesh") {
-      p = {{"-i", label.string(), "-o", bone.string()}, {label}, {bone}};
+      // The CT too: the surface moves onto its bone edge (sub-voxel).
+      p = {{"-i", label.string(), "-o", bone.string(), "--ct", input_.string()}, {label, input_}, {bone}};
+      if (auto uid = forwarded_.find("series-uid"); uid != forwarded_.end() && !uid->second.empty())
+        p.args.insert(p.args.end(), {"--series-uid", uid->second});
     } else if (stage == "sample") {
       p = {{"-i", bone.string(), "-o", points.string()}, {bone}, {points}};
     } else if (stage == "fit") {

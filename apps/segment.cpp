@@ -105,6 +105,8 @@ class SegmentCommand : public cli::Command {
         {"head_center_mm", vec(s.head_center_mm)},
         {"search_radius_mm", s.search_radius_mm},
         {"head_depth_mm", s.head_depth_mm},
+        {"edge_coverage", s.edge_coverage},
+        {"edge_rms_mm", s.edge_rms_mm},
         {"threshold_voxels", s.threshold_voxels},
         {"label_voxels", s.label_voxels},
         {"warnings", warnings},

@@ -27,7 +27,8 @@ TEST(Sampling, PhantomChainPutsArticularPointsOnTheTrueHead) {
     const phantom::Phantom p = phantom::makePhantom(o);
     imaging::SegmentOptions so;
     so.side = c.right ? imaging::Side::Right : imaging::Side::Left;
-    const mesh::TriangleMesh m = mesh::extractSurface(imaging::segmentHead(p.ct, so), {});
+    mesh::TriangleMesh m = mesh::extractSurface(imaging::segmentHead(p.ct, so), {});
+    mesh::snapToEdges(m, p.ct, {});
     sampling::SelectOptions sel_options;
     const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, sel_options);
     const auto head = geometry::makeSurface(p.head);
@@ -40,7 +41,10 @@ TEST(Sampling, PhantomChainPutsArticularPointsOnTheTrueHead) {
     const double rms = std::sqrt(sum / sel.indices.size());
     SCOPED_TRACE(geometry::modelName(c.model));
     EXPECT_GT(sel.indices.size(), 2000u);
-    EXPECT_LT(rms, 0.5 * p.ct.geometry.spacing.mean()) << "RMS " << rms << " mean " << mean;
+    // On the CT's edge: a fraction of the in-plane voxel, and hardly outside
+    // on average (a 1.5 mm cortex under 0.5 mm of blur: about 0.1 mm, see imaging/edges.hpp).
+    EXPECT_LT(rms, 0.3 * p.ct.geometry.spacing.minCoeff()) << "RMS " << rms << " mean " << mean;
+    EXPECT_LT(std::abs(mean), 0.15) << "mean " << mean;
     RecordProperty(geometry::modelName(c.model) + "_rms_mm", std::to_string(rms));
     // The sphere of the selected patch: centre of the true head within 0.5 mm for a sphere.
     if (c.model == geometry::ShapeModel::Sphere) {

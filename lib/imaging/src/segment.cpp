@@ -18,7 +18,9 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/geometry/fibonacci.hpp"
 #include "articula/geometry/sphere_fit.hpp"
+#include "articula/imaging/edges.hpp"
 #include "itk_bridge.hpp"
 
 namespace articula::imaging {
@@ -114,6 +116,220 @@ Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
   return coarse;
 }
 
+// A joint head's cap is nearly spherical: the RMS of its edges about their
+// sphere stays below this share of the radius; an ellipsoidal trochanter or
+// a tuberosity does not.
+constexpr double kMaxRelativeRms = 0.03;
+constexpr int kRayCount = 512;
+
+/// A head measured from a point inside it: the sphere through the first bone
+/// edges seen on rays from that point, and the edges themselves.
+struct HeadCandidate {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0, coverage = 0, rms_mm = 0;  // coverage: share of the rays whose edge lies on the sphere
+  std::vector<double> edge_mm;                  // per ray of the lattice, from `center`; NaN: no edge on the sphere
+  double area() const { return coverage * 4 * M_PI * radius * radius; }
+  /// Edges on a third of the rays, within 3 % of the radius: a head's cap
+  /// seen through a visible gap. (Real femoral and humeral heads: 1-2.5 %.)
+  bool wellMeasured() const { return !edge_mm.empty() && coverage >= 0.3 && rms_mm <= kMaxRelativeRms * radius; }
+};
+
+/// Casts kRayCount rays (Fibonacci lattice) from `start`, takes the first
+/// bone edge on each (imaging/edges.hpp: full resolution, sub-voxel), and
+/// fits a sphere to the edges within a band of the median distance, twice
+/// tightening the band; then once more from the fitted centre, so that the
+/// rays cross the head's surface nearly normally.
+/// Hand-written: ITK has no ray-cast edge detector; a sphere through edges
+/// that agree is the model a joint head's cap calls for.
+HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& start, const SegmentOptions& options) {
+  EdgeSearch search;
+  search.step_mm = 0.15;
+  search.min_inside_hu = options.hu_min;
+  const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
+  HeadCandidate c;
+  c.center = start;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<Eigen::Vector3d> edges(kRayCount, Eigen::Vector3d::Constant(NAN));
+    std::vector<double> distances;
+    for (int n = 0; n < kRayCount; ++n) {
+      const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
+      const Edge e = firstEdgeAlongRay(volume, c.center, u, 0.4 * r_lo, 1.25 * r_hi, search);
+      if (!e.found) continue;
+      edges[static_cast<size_t>(n)] = c.center + e.offset_mm * u;
+      distances.push_back(e.offset_mm);
+    }
+    if (distances.size() < 10) return c;
+    std::nth_element(distances.begin(), distances.begin() + static_cast<long>(distances.size() / 2), distances.end());
+    geometry::Sphere sphere{c.center, distances[distances.size() / 2]};
+    const double voxel = volume.geometry.spacing.maxCoeff();
+    std::vector<char> inlier(edges.size(), 0);
+    for (double band_share : {0.12, 0.06, 0.04}) {
+      const double band = std::max({band_share * sphere.radius, 0.75 * voxel, 1.0});
+      std::vector<Eigen::Vector3d> kept;
+      for (size_t n = 0; n < edges.size(); ++n) {
+        inlier[n] = !std::isnan(edges[n][0]) && std::abs((edges[n] - sphere.center).norm() - sphere.radius) <= band;
+        if (inlier[n]) kept.push_back(edges[n]);
+      }
+      if (kept.size() < 10) return c;
+      Eigen::MatrixX3d points(static_cast<Eigen::Index>(kept.size()), 3);
+      for (size_t i = 0; i < kept.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = kept[i].transpose();
+      try {
+        sphere = geometry::fitSphere(points);
+      } catch (const ProcessingError&) {
+        return c;  // degenerate support (a flat or tiny patch): no head here
+      }
+    }
+    c.center = sphere.center;
+    c.radius = sphere.radius;
+    double sse = 0;
+    int used = 0;
+    c.edge_mm.assign(edges.size(), NAN);
+    for (size_t n = 0; n < edges.size(); ++n) {
+      if (!inlier[n]) continue;
+      const double residual = (edges[n] - sphere.center).norm() - sphere.radius;
+      sse += residual * residual;
+      ++used;
+      // The edge's distance from the final centre along its ray's direction
+      // (the ray left from the previous centre, a fraction of a mm away).
+      c.edge_mm[n] = (edges[n] - sphere.center).dot(geometry::fibonacciDirection(static_cast<int>(n), kRayCount));
+    }
+    c.coverage = static_cast<double>(used) / kRayCount;
+    c.rms_mm = std::sqrt(sse / std::max(used, 1));
+  }
+  return c;
+}
+
+/// A bone-surface voxel of the search's coarse grid and its inward HU gradient.
+struct Voter {
+  Eigen::Vector3d x, n;
+};
+
+/// The Hough peak refined by a least-squares sphere through the surface
+/// voxels facing it at about its radius (the votes only locate it to a
+/// cell); coverage: the share of that sphere's surface that took part.
+HeadCandidate sphereOfFacingVoxels(const Eigen::Vector3d& peak, const std::vector<Voter>& voters,
+                                   const SegmentOptions& options, double cell_mm, double cell_area) {
+  const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
+  HeadCandidate c;
+  c.center = peak;
+  std::vector<double> distances;
+  for (const Voter& voter : voters) {
+    const Eigen::Vector3d d = peak - voter.x;
+    const double t = d.dot(voter.n);
+    if (t >= r_lo && t <= r_hi && (d - t * voter.n).norm() <= 1.5 * cell_mm) distances.push_back(t);
+  }
+  if (distances.empty()) return c;
+  std::nth_element(distances.begin(), distances.begin() + static_cast<long>(distances.size() / 2), distances.end());
+  c.radius = distances[distances.size() / 2];
+  size_t used = 0;
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    std::vector<Eigen::Vector3d> facing;  // surface voxels near the sphere, their normals towards its centre
+    for (const Voter& voter : voters) {
+      const Eigen::Vector3d d = c.center - voter.x;
+      const double t = d.norm();
+      if (std::abs(t - c.radius) <= 0.25 * c.radius && d.dot(voter.n) >= 0.9 * t) facing.push_back(voter.x);
+    }
+    used = facing.size();
+    if (used < 10) break;
+    Eigen::MatrixX3d points(static_cast<Eigen::Index>(used), 3);
+    for (size_t i = 0; i < used; ++i) points.row(static_cast<Eigen::Index>(i)) = facing[i].transpose();
+    try {
+      const geometry::Sphere sphere = geometry::fitSphere(points);
+      c.center = sphere.center;
+      c.radius = sphere.radius;
+    } catch (const ProcessingError&) {
+      break;  // degenerate support (a flat or tiny patch): keep the Hough estimate
+    }
+  }
+  c.coverage = static_cast<double>(used) * cell_area / (4 * M_PI * c.radius * c.radius);
+  return c;
+}
+
+/// Nearest direction of the ray lattice, through a table over polar and
+/// azimuth angles (a voxel's direction is looked up millions of times).
+class LatticeLookup {
+ public:
+  LatticeLookup() : nearest_(kPolarBins * kAzimuthBins) {
+    for (int a = 0; a < kPolarBins; ++a)
+      for (int b = 0; b < kAzimuthBins; ++b) {
+        const double polar = M_PI * (a + 0.5) / kPolarBins, azimuth = 2 * M_PI * (b + 0.5) / kAzimuthBins;
+        const Eigen::Vector3d u(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+        int best = 0;
+        for (int n = 1; n < kRayCount; ++n)
+          if (u.dot(geometry::fibonacciDirection(n, kRayCount)) > u.dot(geometry::fibonacciDirection(best, kRayCount))) best = n;
+        nearest_[static_cast<size_t>(a * kAzimuthBins + b)] = best;
+      }
+  }
+  int operator()(const Eigen::Vector3d& u) const {
+    const double polar = std::acos(std::clamp(u[2], -1.0, 1.0));
+    double azimuth = std::atan2(u[1], u[0]);
+    if (azimuth < 0) azimuth += 2 * M_PI;
+    const int a = std::min(kPolarBins - 1, static_cast<int>(polar / M_PI * kPolarBins));
+    const int b = std::min(kAzimuthBins - 1, static_cast<int>(azimuth / (2 * M_PI) * kAzimuthBins));
+    return nearest_[static_cast<size_t>(a * kAzimuthBins + b)];
+  }
+
+ private:
+  static constexpr int kPolarBins = 64, kAzimuthBins = 128;
+  std::vector<int> nearest_;
+};
+
+/// The head's edge distance per lattice direction, with the holes of its cap
+/// (a missed edge, the fovea's pit) filled from their neighbours: a
+/// direction without an edge whose nearest neighbours mostly have one lies
+/// inside the cap. The neck's directions, without neighbours on the cap, stay empty.
+std::vector<double> capEdges(const HeadCandidate& head) {
+  std::vector<double> edge = head.edge_mm;
+  constexpr int kNeighbours = 6;
+  std::vector<std::vector<int>> neighbours(kRayCount);
+  for (int n = 0; n < kRayCount; ++n) {
+    const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
+    std::vector<std::pair<double, int>> by_angle;
+    for (int m = 0; m < kRayCount; ++m)
+      if (m != n) by_angle.emplace_back(-u.dot(geometry::fibonacciDirection(m, kRayCount)), m);
+    std::partial_sort(by_angle.begin(), by_angle.begin() + kNeighbours, by_angle.end());
+    for (int k = 0; k < kNeighbours; ++k) neighbours[static_cast<size_t>(n)].push_back(by_angle[static_cast<size_t>(k)].second);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<double> next = edge;
+    for (int n = 0; n < kRayCount; ++n) {
+      if (!std::isnan(edge[static_cast<size_t>(n)])) continue;
+      double sum = 0;
+      int count = 0;
+      for (int m : neighbours[static_cast<size_t>(n)])
+        if (!std::isnan(edge[static_cast<size_t>(m)])) sum += edge[static_cast<size_t>(m)], ++count;
+      if (count >= 4) next[static_cast<size_t>(n)] = sum / count;
+    }
+    edge = next;
+  }
+  return edge;
+}
+
+/// Removes from the bone mask what lies beyond the head's edge in the
+/// directions of its cap: the joint gap and the socket, however narrow the
+/// gap and whatever the closing bridged. The margin keeps the partial-volume
+/// voxels of the head's own edge (the mesh stage places the surface on the
+/// CT's edge within them).
+void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head) {
+  static const LatticeLookup lookup;
+  const std::vector<double> edge = capEdges(head);
+  const ImageGeometry& g = mask.geometry;
+  const double margin = std::max(0.5, 0.5 * g.spacing.maxCoeff());
+  long long removed = 0;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        std::uint8_t& m = mask.at(i, j, k);
+        if (!m) continue;
+        const Eigen::Vector3d d = g.toPhysical(Eigen::Vector3d(i, j, k)) - head.center;
+        const double r = d.norm();
+        if (r < 0.7 * head.radius || r > 1.6 * head.radius) continue;
+        const double e = edge[static_cast<size_t>(lookup(d / r))];
+        if (!std::isnan(e) && r > e + margin) m = 0, ++removed;
+      }
+  log::debug("cut beyond the head's edges: " + std::to_string(removed) + " voxels");
+}
+
 /// Automatic head search: a 3-D Hough transform for spheres on a grid of
 /// about options.search_spacing_mm. Every voxel on the bone's surface votes
 /// along its inward HU gradient at the distances a head radius can have: the
@@ -123,7 +339,7 @@ Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
 /// voxels facing them; the strongest on the requested side whose sphere is a
 /// plausible head is the head.
 /// Hand-written: ITK's Hough filters are 2-D only.
-bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector3d& center, double& radius) {
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head) {
   const ImageGeometry& g = volume.geometry;
   Eigen::Vector3i factor;
   for (int a = 0; a < 3; ++a)
@@ -143,7 +359,6 @@ bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector
     const float hu = coarse.at(i, j, k);
     return hu >= options.hu_min && hu <= options.hu_max;
   };
-  struct Voter { Eigen::Vector3d x, n; };
   std::vector<Voter> voters;
   for (int k = 1; k + 1 < cg.size[2]; ++k)
     for (int j = 1; j + 1 < cg.size[1]; ++j)
@@ -179,7 +394,7 @@ bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector
       if (cellOf(voter.x + t * voter.n, v)) votes[static_cast<size_t>(cg.linear(v[0], v[1], v[2]))] += 1.0f;
     }
   const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
-  struct Peak { Eigen::Vector3d x; double votes, radius = 0, coverage = 0; };
+  struct Peak { Eigen::Vector3d x; double votes; };
   std::vector<Peak> peaks;
   for (int k = 1; k + 1 < cg.size[2]; ++k)
     for (int j = 1; j + 1 < cg.size[1]; ++j)
@@ -196,61 +411,51 @@ bool findHead(const Volume& volume, const SegmentOptions& options, Eigen::Vector
   std::vector<Peak> kept;  // strongest first, at least a head radius apart
   for (const Peak& p : peaks) {
     bool separate = true;
-    for (const Peak& q : kept) separate = separate && (p.x - q.x).norm() > r_lo;
+    for (const Peak& q : kept) separate = separate && (p.x - q.x).norm() > 0.5 * r_lo;
     if (separate) kept.push_back(p);
-    if (kept.size() == 5) break;
+    if (kept.size() == 8) break;
   }
-  // Each peak refined by a least-squares sphere through the surface voxels
-  // facing it at about its radius (the votes only locate it to a cell);
-  // coverage: the share of that sphere's surface that took part.
+  // Each peak measured by rays cast from it at full resolution: the first
+  // bone edge on each ray, and a sphere through the edges that agree.
+  std::vector<HeadCandidate> candidates;
+  for (const Peak& p : kept) {
+    HeadCandidate c = measureHeadByRays(volume, p.x, options);
+    log::debug("head candidate " + vec(p.x) + " mm (" + std::to_string(p.votes) + " votes) -> centre " + vec(c.center) +
+               " mm, radius " + std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage) + ", RMS " +
+               std::to_string(c.rms_mm) + " mm");
+    candidates.push_back(std::move(c));
+  }
+  // The plausible head with the largest spherical bone surface: a trochanter
+  // or a tuberosity is smaller and less spherical, the outer surface of a
+  // socket is never the first edge seen from the centre.
+  const HeadCandidate* best = nullptr;
+  for (const HeadCandidate& c : candidates) {
+    const bool plausible = c.wellMeasured() && c.radius >= r_lo && c.radius <= r_hi &&
+                           c.coverage >= options.min_coverage && (c.center[0] < mid_x) == (options.side == Side::Right) &&
+                           std::abs(c.center[0] - mid_x) >= options.midline_margin_mm && insideVolume(g, c.center);
+    if (plausible && (!best || c.area() > best->area())) best = &c;
+  }
+  if (best) {
+    head = *best;
+    return true;
+  }
+  // No candidate's edges make a sphere: coarse voxels (3 mm) blur the gap
+  // away and the rays meet socket and pelvis. Then the strongest peak whose
+  // sphere through the surface voxels facing it (at about its radius) is a
+  // plausible head; no cut along edges follows (edge_mm stays empty).
   const double cell_area = cg.spacing.prod() / cg.spacing.minCoeff();
-  for (Peak& p : kept) {
-    std::vector<double> distances;
-    for (const Voter& voter : voters) {
-      const Eigen::Vector3d d = p.x - voter.x;
-      const double t = d.dot(voter.n);
-      if (t >= r_lo && t <= r_hi && (d - t * voter.n).norm() <= 1.5 * cg.spacing.minCoeff()) distances.push_back(t);
+  for (const Peak& p : kept) {
+    HeadCandidate c = sphereOfFacingVoxels(p.x, voters, options, cg.spacing.minCoeff(), cell_area);
+    log::debug("head candidate " + vec(p.x) + " mm by facing surface voxels: centre " + vec(c.center) + " mm, radius " +
+               std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage));
+    if (c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage &&
+        (c.center[0] < mid_x) == (options.side == Side::Right) && std::abs(c.center[0] - mid_x) >= options.midline_margin_mm &&
+        insideVolume(g, c.center)) {
+      head = c;
+      return true;
     }
-    if (distances.empty()) continue;
-    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-    p.radius = distances[distances.size() / 2];
-    size_t used = 0;
-    for (int iteration = 0; iteration < 5; ++iteration) {
-      std::vector<Eigen::Vector3d> facing;  // surface voxels near the sphere, their normals towards its centre
-      for (const Voter& voter : voters) {
-        const Eigen::Vector3d d = p.x - voter.x;
-        const double t = d.norm();
-        if (std::abs(t - p.radius) <= 0.25 * p.radius && d.dot(voter.n) >= 0.9 * t) facing.push_back(voter.x);
-      }
-      used = facing.size();
-      if (used < 10) break;
-      Eigen::MatrixX3d points(static_cast<Eigen::Index>(used), 3);
-      for (size_t i = 0; i < used; ++i) points.row(static_cast<Eigen::Index>(i)) = facing[i].transpose();
-      try {
-        const geometry::Sphere sphere = geometry::fitSphere(points);
-        p.x = sphere.center;
-        p.radius = sphere.radius;
-      } catch (const ProcessingError&) {
-        break;  // degenerate support (a flat or tiny patch): keep the Hough estimate
-      }
-    }
-    p.coverage = used * cell_area / (4 * M_PI * p.radius * p.radius);
-    log::debug("head candidate " + vec(p.x) + " mm: " + std::to_string(p.votes) + " votes, radius " +
-               std::to_string(p.radius) + " mm, coverage " + std::to_string(p.coverage));
   }
-  // The strongest peak whose refined sphere is still a plausible head.
-  const Peak* best = nullptr;
-  for (const Peak& p : kept)
-    if (p.radius >= r_lo && p.radius <= r_hi && p.coverage >= options.min_coverage &&
-        (p.x[0] < mid_x) == (options.side == Side::Right) && std::abs(p.x[0] - mid_x) >= options.midline_margin_mm &&
-        insideVolume(g, p.x)) {
-      best = &p;
-      break;
-    }
-  if (!best) return false;
-  center = best->x;
-  radius = best->radius;
-  return true;
+  return false;
 }
 
 /// Marker watershed on the signed distance to the bone surface: the head's
@@ -399,28 +604,46 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     throw InputError(m.str());
   }
 
-  // 2. The head: given, or the deepest bone on the requested side.
+  // 2. The head: measured from the seed point, or searched on the requested side.
   double depth = 0;
   Eigen::Vector3d center;
+  HeadCandidate head_found;
+  bool measured = false;  // a sphere through the head's edges (its rays cut the socket off)
   if (options.seed_point) {
     center = *options.seed_point;
     summary.seed_source = "seed-point";
     if (!insideVolume(g, center))
       throw InputError("--seed-point " + vec(center) + " lies outside the volume");
     depth = options.max_head_radius_mm;  // crop generously around a given seed
+    head_found = measureHeadByRays(volume, center, options);
+    measured = head_found.radius >= options.min_head_radius_mm && head_found.radius <= options.max_head_radius_mm &&
+               head_found.coverage >= options.min_coverage && head_found.rms_mm <= kMaxRelativeRms * head_found.radius &&
+               (head_found.center - center).norm() <= head_found.radius;
+    if (measured) center = head_found.center, depth = head_found.radius;
   } else {
     const std::string joint = options.joint == Joint::Hip ? "hip" : "shoulder";
     const std::string side = options.side == Side::Right ? "right" : "left";
     summary.seed_source = "automatic (" + joint + ", " + side + ")";
-    if (!findHead(volume, options, center, depth)) {
+    if (!findHead(volume, options, head_found)) {
       std::ostringstream m;
       m << "no " << (options.joint == Joint::Hip ? "femoral" : "humeral") << " head found on the " << side
         << " side: no sphere of radius " << options.min_head_radius_mm << "-" << options.max_head_radius_mm
-        << " mm covers " << options.min_coverage << " of its surface with bone in the HU window (-v lists the candidates);"
+        << " mm has bone edges over " << options.min_coverage << " of its surface within "
+        << kMaxRelativeRms * 100 << " % RMS of its radius (-v lists the candidates);"
         << " give --seed-point X,Y,Z (LPS mm) or adjust --hu-min";
       throw ProcessingError(m.str());
     }
-    log::info("head found at " + vec(center) + " mm, depth " + std::to_string(depth) + " mm");
+    measured = !head_found.edge_mm.empty();
+    center = head_found.center;
+    depth = head_found.radius;
+    log::info("head found at " + vec(center) + " mm, radius " + std::to_string(depth) + " mm" +
+              (measured ? ", edges on " + std::to_string(static_cast<int>(std::lround(100 * head_found.coverage))) +
+                              " % of the rays, RMS " + std::to_string(head_found.rms_mm) + " mm"
+                        : " (by its facing surface voxels: the rays found no spherical edge)"));
+  }
+  if (measured) {
+    summary.edge_coverage = head_found.coverage;
+    summary.edge_rms_mm = head_found.rms_mm;
   }
   summary.seed_mm = center;
 
@@ -461,6 +684,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
         box_raw.voxels[n] = 0, ++removed;
     log::debug("joint-gap valley: " + std::to_string(removed) + " voxels removed from the bone mask");
   }
+  if (measured) cutBeyondEdges(box_raw, head_found);
   const Mask box_mask = fillHoles(box_raw);
   const ImageGeometry& bg = box_mask.geometry;
   const Image<float> box_distance = signedDistance(box_mask);
@@ -468,7 +692,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   // full-resolution bone near it, and once more on the label's deepest point
   // (the seed can sit off-centre where bone is joined). The automatic
   // search's sphere is already centred.
-  const bool recentre = options.seed_point.has_value();
+  const bool recentre = options.seed_point.has_value() && !measured;
   if (recentre) {
     const Eigen::Vector3d start = center;
     double deepest = 0;
@@ -513,24 +737,9 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   // third of a voxel outside in partial volume).
   if (options.level_set_iterations > 0) {
     head = refineByLevelSet(box_hu, head, options.level_set_iterations);
-  } else if (options.surface_hu > options.hu_min) {
-    // Peel twice: only voxels on the label's outer layer, so the cortex keeps
-    // the darker cancellous interior inside.
-    for (int peel = 0; peel < 2; ++peel) {
-      Mask next = head;
-      for (int k = 0; k < bg.size[2]; ++k)
-        for (int j = 0; j < bg.size[1]; ++j)
-          for (int i = 0; i < bg.size[0]; ++i) {
-            if (!head.at(i, j, k) || box_hu.at(i, j, k) >= options.surface_hu) continue;
-            const bool outer = i == 0 || j == 0 || k == 0 || i + 1 == bg.size[0] || j + 1 == bg.size[1] ||
-                               k + 1 == bg.size[2] || !head.at(i - 1, j, k) || !head.at(i + 1, j, k) ||
-                               !head.at(i, j - 1, k) || !head.at(i, j + 1, k) || !head.at(i, j, k - 1) ||
-                               !head.at(i, j, k + 1);
-            if (outer) next.at(i, j, k) = 0;
-          }
-      head = next;
-    }
   }
+  // (Without the contour, the label ends where the HU window does; the mesh
+  // stage places the surface on the CT's edge, imaging/edges.hpp.)
 
   Label label;
   label.geometry = g;

@@ -31,6 +31,7 @@
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/imaging/edges.hpp"
 
 namespace articula::mesh {
 namespace fs = std::filesystem;
@@ -204,6 +205,71 @@ TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& opti
     summary->vertices = mesh.vertices.rows();
   }
   return mesh;
+}
+
+void EdgeSnapOptions::validate() const {
+  if (!(search_mm >= 0 && search_mm <= 10)) throw UsageError("edge search: expected 0 to 10 mm, found " + std::to_string(search_mm));
+  if (!(min_contrast_hu > 0)) throw UsageError("edge contrast must be > 0 HU");
+  if (smoothing_passes < 0 || smoothing_passes > 100) throw UsageError("edge smoothing passes: expected 0 to 100");
+}
+
+void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
+                 EdgeSnapSummary* summary) {
+  options.validate();
+  const Eigen::Index n = mesh.vertices.rows();
+  if (mesh.normals.rows() != n) throw ProcessingError("snapping to the CT's edges needs vertex normals");
+  imaging::EdgeSearch search;
+  // Inwards by a voxel and a half (a label ends where the HU window does,
+  // outside the edge by up to a voxel); outwards by little: beyond a narrow
+  // joint gap lies the socket, whose outer fall must not be taken.
+  search.inward_mm = options.search_mm > 0 ? options.search_mm : std::max(1.5, 1.5 * ct.geometry.spacing.maxCoeff());
+  search.outward_mm = options.search_mm > 0 ? options.search_mm : std::max(0.75, 0.25 * ct.geometry.spacing.maxCoeff());
+  search.min_contrast_hu = options.min_contrast_hu;
+  search.min_inside_hu = options.min_inside_hu;
+  std::vector<double> shift(static_cast<size_t>(n), 0.0);
+  std::vector<char> found(static_cast<size_t>(n), 0);
+  EdgeSnapSummary s;
+  s.vertices = n;
+  for (Eigen::Index v = 0; v < n; ++v) {
+    const imaging::Edge e =
+        imaging::locateEdge(ct, mesh.vertices.row(v).transpose(), mesh.normals.row(v).transpose(), search);
+    if (!e.found) continue;
+    shift[static_cast<size_t>(v)] = e.offset_mm;
+    found[static_cast<size_t>(v)] = 1;
+    ++s.on_edge;
+  }
+  // Neighbour averages over the triangles' edges: the found shifts smoothed,
+  // the others taken from found neighbours (repeatedly, as far as the passes reach).
+  std::vector<std::vector<int>> neighbours(static_cast<size_t>(n));
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const int a = mesh.triangles(t, e), b = mesh.triangles(t, (e + 1) % 3);
+      neighbours[static_cast<size_t>(a)].push_back(b);
+      neighbours[static_cast<size_t>(b)].push_back(a);
+    }
+  const int passes = std::max(options.smoothing_passes, 1);
+  for (int pass = 0; pass < passes + 8; ++pass) {
+    std::vector<double> next = shift;
+    std::vector<char> next_found = found;
+    for (size_t v = 0; v < shift.size(); ++v) {
+      if (pass >= passes && found[v]) continue;  // later passes only reach the vertices without an edge
+      double sum = found[v] ? shift[v] : 0.0;
+      int count = found[v] ? 1 : 0;
+      for (int w : neighbours[v])
+        if (found[static_cast<size_t>(w)]) sum += shift[static_cast<size_t>(w)], ++count;
+      if (count > 0) next[v] = sum / count, next_found[v] = 1;
+    }
+    shift.swap(next);
+    found.swap(next_found);
+  }
+  for (Eigen::Index v = 0; v < n; ++v) {
+    const double d = found[static_cast<size_t>(v)] ? shift[static_cast<size_t>(v)] : 0.0;
+    mesh.vertices.row(v) += d * mesh.normals.row(v);
+    s.mean_shift_mm += d / static_cast<double>(n);
+    s.mean_abs_shift_mm += std::abs(d) / static_cast<double>(n);
+  }
+  mesh.normals = fromVtk(withNormals(toVtk(mesh))).normals;
+  if (summary) *summary = s;
 }
 
 void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {

@@ -1,10 +1,13 @@
 #pragma once
 // Segmentation of one joint head (femoral or humeral) from a CT volume:
 // HU threshold, optional ROI, closing and hole filling, automatic head
-// finding (a Hough transform for spheres on the chosen side, ~2 mm grid), then a marker
+// finding (a Hough transform for spheres on the chosen side, ~2 mm grid,
+// whose candidates are measured by rays at full resolution: the sphere
+// through the first bone edges seen from inside), the bone beyond those
+// edges cut off (gap and socket, however narrow the gap), then a marker
 // watershed on the distance to the bone surface, which cuts the head from
-// the socket and the neck at the narrow bone bridges between them; the
-// head's surface at a HU level or, optionally, by a geodesic active contour.
+// the neck at its narrowest; the head's surface at a HU level or,
+// optionally, by a geodesic active contour.
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +50,9 @@ struct SegmentSummary {
   Eigen::Vector3d head_center_mm = Eigen::Vector3d::Zero();
   double search_radius_mm = 0;              // the automatic search's sphere radius (0 with a seed point)
   double head_depth_mm = 0;                 // deepest label point's distance to the label surface
+  // The sphere through the head's CT edges seen from its centre (0 when a
+  // seed point gave no plausible sphere): share of rays with an edge on it, RMS.
+  double edge_coverage = 0, edge_rms_mm = 0;
   long long threshold_voxels = 0;           // voxels in the HU window (within the ROI)
   long long label_voxels = 0;
   std::vector<std::string> warnings;

@@ -43,6 +43,30 @@ struct MeshSummary {
 /// outward normals. Throws InputError if the label has no voxel set.
 TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& options, MeshSummary* summary = nullptr);
 
+struct EdgeSnapOptions {
+  double search_mm = 0;         // edge search either side of a vertex (0: 1.5 voxels inwards, at least 1.5 mm; a quarter voxel outwards, at least 0.75 mm)
+  double min_contrast_hu = 150; // least fall across an edge (see imaging/edges.hpp)
+  double min_inside_hu = 200;   // the bone side of an edge reaches at least this
+  int smoothing_passes = 2;     // neighbour averages of the shifts (CT noise)
+  /// Throws UsageError naming the first invalid option.
+  void validate() const;
+};
+
+struct EdgeSnapSummary {
+  long long vertices = 0, on_edge = 0;  // vertices, those with an edge found along their normal
+  double mean_shift_mm = 0;             // mean signed shift along the outward normal
+  double mean_abs_shift_mm = 0;
+};
+
+/// Moves every vertex along its normal onto the CT's bone edge (the
+/// steepest HU fall, imaging::locateEdge), so that the surface lies where
+/// the cortex meets soft tissue at sub-voxel precision and not where the
+/// label's voxels end; shifts averaged over neighbours against CT noise,
+/// vertices without an edge (a cut through bone) follow their neighbours.
+/// Normals are recomputed. The CT's grid may differ from the label's.
+void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
+                 EdgeSnapSummary* summary = nullptr);
+
 /// Writes .vtp, .stl or .ply (chosen by extension) atomically.
 void writeMesh(const std::filesystem::path& path, const TriangleMesh& mesh, bool overwrite = true);
 /// Reads .vtp, .stl, .ply, .vtk or .obj; computes normals if the file has none.

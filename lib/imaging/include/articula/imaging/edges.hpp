@@ -1,0 +1,51 @@
+#pragma once
+// Where a CT's bone surface is, to a fraction of a voxel: the steepest fall
+// of the HU profile along a line leaving the bone (the gradient maximum of
+// a blurred step, which a symmetric point-spread leaves in place), not where
+// a fixed HU threshold cuts a blurred cortex. A cortex thinner than about
+// three point-spread widths pulls it outwards a little (its inner rise adds
+// slope; 0.1 mm for 1.5 mm of cortex under 0.7 mm of blur), far less than a
+// threshold or the local half maximum, which a thin cortex's lowered peak
+// moves outwards by twice that. Plain buffers, no ITK: the
+// head search and the mesh stage both read profiles.
+#include <Eigen/Core>
+
+#include "articula/imaging/image.hpp"
+
+namespace articula::imaging {
+
+/// HU at a physical LPS point by trilinear interpolation; NaN outside the grid.
+double interpolate(const Volume& volume, const Eigen::Vector3d& x);
+
+struct EdgeSearch {
+  double inward_mm = 2.0;         // search from this far inside the start point ...
+  double outward_mm = 2.0;        // ... to this far outside it
+  double step_mm = 0.1;           // profile sampling step
+  double smoothing_mm = 0.0;      // derivative-of-Gaussian scale (0: a quarter of the finest voxel, at least 0.15 mm)
+  double min_contrast_hu = 150;   // least fall across the edge (within 1.5 mm either side)
+  double min_inside_hu = 200;     // the bone side of the edge reaches at least this
+};
+
+struct Edge {
+  bool found = false;
+  double offset_mm = 0;       // along the direction from the start point (positive: outwards)
+  double slope_hu_per_mm = 0; // the fall's steepest slope (positive)
+  double inside_hu = 0, outside_hu = 0;  // the profile's maximum before and minimum after the edge
+};
+
+/// The bone's outer edge on the line x + t * outward (outward a unit vector
+/// pointing out of the bone), t in [-inward_mm, outward_mm]: the steepest fall
+/// of the smoothed profile, refined by a parabola through its three samples.
+/// Not found when the line leaves the grid, or the fall is weaker than
+/// min_contrast_hu or does not start from bone.
+Edge locateEdge(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& outward,
+                const EdgeSearch& search);
+
+/// The first bone edge met going out from `origin` along `direction`
+/// between from_mm and to_mm (for rays cast from inside a head): the first
+/// fall of the smoothed profile that is at least min_contrast_hu deep and
+/// starts from bone. Not found when there is none before to_mm.
+Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                       double from_mm, double to_mm, const EdgeSearch& search);
+
+}  // namespace articula::imaging

@@ -1,0 +1,149 @@
+#include "articula/imaging/edges.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace articula::imaging {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// A fall counts as the bone's edge only if it is this steep relative to the
+// steepest fall on the same ray: trabecular texture inside a head falls too,
+// but far less than a cortex meeting soft tissue.
+constexpr double kRelativeStrength = 0.25;
+constexpr double kContrastReachMm = 1.5;  // the fall is measured within this distance either side
+
+/// The profile I(t0 + n step), smoothed by a Gaussian of sigma_mm, and its derivative.
+struct Profile {
+  double t0 = 0, step = 0.1;
+  std::vector<double> value, slope;
+  bool complete = true;  // every sample inside the grid
+
+  double t(size_t n) const { return t0 + static_cast<double>(n) * step; }
+};
+
+Profile sampleProfile(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from,
+                      double to, const EdgeSearch& search) {
+  Profile p;
+  p.t0 = from;
+  p.step = search.step_mm;
+  const auto count = static_cast<size_t>(std::floor((to - from) / p.step)) + 1;
+  std::vector<double> raw(count);
+  for (size_t n = 0; n < count; ++n) {
+    raw[n] = interpolate(volume, x + p.t(n) * u);
+    if (std::isnan(raw[n])) {
+      p.complete = false;
+      raw.resize(n);
+      break;
+    }
+  }
+  const double sigma_mm =
+      search.smoothing_mm > 0 ? search.smoothing_mm : std::max(0.15, 0.25 * volume.geometry.spacing.minCoeff());
+  const double s = sigma_mm / p.step;
+  const int r = static_cast<int>(std::ceil(3 * s));
+  std::vector<double> w(static_cast<size_t>(2 * r + 1)), dw(w.size());
+  double sum = 0;
+  for (int q = -r; q <= r; ++q) sum += w[static_cast<size_t>(q + r)] = std::exp(-0.5 * q * q / (s * s));
+  for (int q = -r; q <= r; ++q) {
+    w[static_cast<size_t>(q + r)] /= sum;
+    dw[static_cast<size_t>(q + r)] = -q / (s * s) * w[static_cast<size_t>(q + r)] / p.step;  // d/dt of the kernel
+  }
+  const auto m = static_cast<long>(raw.size());
+  p.value.assign(raw.size(), 0.0);
+  p.slope.assign(raw.size(), 0.0);
+  for (long n = 0; n < m; ++n)
+    for (int q = -r; q <= r; ++q) {
+      const double v = raw[static_cast<size_t>(std::clamp(n - q, 0L, m - 1))];
+      p.value[static_cast<size_t>(n)] += w[static_cast<size_t>(q + r)] * v;
+      p.slope[static_cast<size_t>(n)] += dw[static_cast<size_t>(q + r)] * v;
+    }
+  return p;
+}
+
+/// The edge at sample n (a local minimum of the slope): sub-sample offset by a
+/// parabola through the slopes at n-1, n, n+1, with the contrast across it.
+Edge edgeAt(const Profile& p, size_t n) {
+  Edge e;
+  const double a = p.slope[n - 1], b = p.slope[n], c = p.slope[n + 1];
+  const double curvature = a - 2 * b + c;
+  const double shift = curvature > 0 ? std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5) : 0.0;
+  e.offset_mm = p.t(n) + shift * p.step;
+  e.slope_hu_per_mm = -b;
+  const auto reach = static_cast<size_t>(std::lround(kContrastReachMm / p.step));
+  const size_t lo = n > reach ? n - reach : 0, hi = std::min(p.value.size() - 1, n + reach);
+  e.inside_hu = *std::max_element(p.value.begin() + static_cast<long>(lo), p.value.begin() + static_cast<long>(n) + 1);
+  e.outside_hu = *std::min_element(p.value.begin() + static_cast<long>(n), p.value.begin() + static_cast<long>(hi) + 1);
+  return e;
+}
+
+bool strongEnough(const Edge& e, const EdgeSearch& search) {
+  return e.inside_hu - e.outside_hu >= search.min_contrast_hu && e.inside_hu >= search.min_inside_hu;
+}
+
+bool isFallingMinimum(const Profile& p, size_t n) {
+  return p.slope[n] < 0 && p.slope[n] <= p.slope[n - 1] && p.slope[n] < p.slope[n + 1];
+}
+
+}  // namespace
+
+double interpolate(const Volume& volume, const Eigen::Vector3d& x) {
+  const ImageGeometry& g = volume.geometry;
+  const Eigen::Vector3d idx = g.toIndex(x);
+  Eigen::Vector3i base;
+  Eigen::Vector3d frac;
+  for (int a = 0; a < 3; ++a) {
+    if (!(idx[a] >= 0 && idx[a] <= g.size[a] - 1)) return kNaN;
+    base[a] = std::min(static_cast<int>(std::floor(idx[a])), std::max(g.size[a] - 2, 0));
+    frac[a] = idx[a] - base[a];
+  }
+  double value = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    double weight = 1;
+    Eigen::Vector3i v = base;
+    for (int a = 0; a < 3; ++a) {
+      const bool up = corner >> a & 1;
+      weight *= up ? frac[a] : 1 - frac[a];
+      if (up) v[a] = std::min(v[a] + 1, g.size[a] - 1);
+    }
+    if (weight != 0) value += weight * volume.at(v[0], v[1], v[2]);
+  }
+  return value;
+}
+
+Edge locateEdge(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& outward,
+                const EdgeSearch& search) {
+  // Sampled beyond the window so that the smoothing and the contrast see both sides.
+  const double margin = kContrastReachMm;
+  const Profile p = sampleProfile(volume, x, outward, -search.inward_mm - margin, search.outward_mm + margin, search);
+  if (!p.complete || p.value.size() < 3) return {};
+  size_t best = 0;
+  for (size_t n = 1; n + 1 < p.value.size(); ++n) {
+    const double t = p.t(n);
+    if (t < -search.inward_mm || t > search.outward_mm || !isFallingMinimum(p, n)) continue;
+    if (best == 0 || p.slope[n] < p.slope[best]) best = n;
+  }
+  if (best == 0) return {};
+  Edge e = edgeAt(p, best);
+  e.found = strongEnough(e, search);
+  return e;
+}
+
+Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                       double from_mm, double to_mm, const EdgeSearch& search) {
+  const Profile p = sampleProfile(volume, origin, direction, from_mm, to_mm + kContrastReachMm, search);
+  if (p.value.size() < 3) return {};
+  double steepest = 0;
+  for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n) steepest = std::min(steepest, p.slope[n]);
+  for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n) {
+    if (!isFallingMinimum(p, n) || p.slope[n] > kRelativeStrength * steepest) continue;
+    Edge e = edgeAt(p, n);
+    if (!strongEnough(e, search)) continue;
+    e.found = true;
+    return e;
+  }
+  return {};
+}
+
+}  // namespace articula::imaging
