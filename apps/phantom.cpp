@@ -15,9 +15,12 @@ class PhantomCommand : public cli::Command {
  public:
   std::string name() const override { return "phantom"; }
   std::string description() const override {
-    return "Write a synthetic hip CT (NIfTI + DICOM series) with a femoral head of known shape, and truth.json";
+    return "Write a synthetic hip CT (NIfTI + DICOM series) with a femoral head of known shape (or both hips), and truth.json";
   }
-  std::string example() const override { return "articula phantom -o phantom --seed 3 --model ellipsoid --gap 2"; }
+  std::string example() const override {
+    return "articula phantom -o phantom --seed 3 --model ellipsoid --gap 2\n"
+           "  articula phantom -o pelvis --both-hips --radius-range 17,30 --gap 1.5 --spacing 1.5,1.5,3 --fovea --osteoporotic";
+  }
   void declare(CLI::App& app) override {
     app.add_option("-o,--output", output_, "Output folder (phantom.nii.gz, dicom/, truth.json)")->required();
     app.add_option("--model", model_, "Head shape: sphere, ellipsoid, superellipsoid, ovoid, superovoid (default: by seed)");
@@ -27,10 +30,49 @@ class PhantomCommand : public cli::Command {
     app.add_option("--noise", noise_, "Noise standard deviation (HU)")->capture_default_str();
     app.add_option("--blur", blur_, "Point-spread standard deviation (mm)")->capture_default_str();
     app.add_flag("--ras", ras_, "Store the grid RAS (direction diag(-1,-1,1)), like many NIfTI files");
+    radius_option_ = app.add_option("--radius", radius_, "Head's mean radius in mm (default: drawn by seed from --radius-range)");
+    app.add_option("--radius-range", radius_range_, "Range LO,HI (mm) of the seed-drawn head radius")
+        ->delimiter(',')->expected(2)->capture_default_str();
+    app.add_option("--socket", socket_, "Acetabulum: congruent (a shell at the gap) or spherical (larger radius, gap widening to the rim)")
+        ->check(CLI::IsMember({"congruent", "spherical"}))->capture_default_str();
+    app.add_option("--socket-excess", options_.socket_excess_mm, "Spherical socket: inner radius minus (head's largest radius + gap), mm")
+        ->capture_default_str();
+    app.add_option("--socket-wall", options_.socket_wall_mm, "Acetabular wall thickness (mm)")->capture_default_str();
+    socket_cortical_ = app.add_option("--socket-cortical-hu", socket_cortical_hu_, "Socket cortex HU (default: the femur's)");
+    socket_cancellous_ = app.add_option("--socket-cancellous-hu", socket_cancellous_hu_, "Socket cancellous HU (default: the femur's)");
+    app.add_flag("--osteoporotic", osteoporotic_,
+                 "Osteoporotic bone: cortex 0.8 mm at 700 HU, cancellous 190 +- 90 HU (the options below override)");
+    cortical_hu_ = app.add_option("--cortical-hu", options_.cortical_hu, "Cortical bone HU")->capture_default_str();
+    cancellous_hu_ = app.add_option("--cancellous-hu", options_.cancellous_hu, "Cancellous bone HU")->capture_default_str();
+    cortical_mm_ = app.add_option("--cortical-mm", options_.cortical_mm, "Cortical thickness (mm)")->capture_default_str();
+    variation_ = app.add_option("--cancellous-variation", options_.cancellous_variation_hu,
+                                "Amplitude of a smooth spatial variation of the cancellous HU")->capture_default_str();
+    app.add_flag("--fovea", options_.fovea, "A fovea capitis pit on the head (radius 5 mm, depth 2 mm)");
+    app.add_flag("--exact", options_.exact_depth,
+                 "Cortex, joint gap and socket wall of exactly the stated widths (default: the original phantom, "
+                 "whose first-order distance makes a 3 mm gap 3.2 mm and a 12 mm wall 16.6 mm on a 21 mm head)");
+    app.add_flag("--both-hips", options_.both_hips,
+                 "Both hips in one field of view with a pelvis-like frame; --side names the head of the top-level truth");
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
     phantom::PhantomOptions o;
+    if (osteoporotic_) o.makeOsteoporotic();
+    // Explicit bone options override the osteoporotic preset.
+    if (cortical_hu_->count()) o.cortical_hu = options_.cortical_hu;
+    if (cancellous_hu_->count()) o.cancellous_hu = options_.cancellous_hu;
+    if (cortical_mm_->count()) o.cortical_mm = options_.cortical_mm;
+    if (variation_->count()) o.cancellous_variation_hu = options_.cancellous_variation_hu;
+    if (socket_cortical_->count()) o.socket_cortical_hu = socket_cortical_hu_;
+    if (socket_cancellous_->count()) o.socket_cancellous_hu = socket_cancellous_hu_;
+    if (!radius_range_.empty()) o.head_radius_range_mm = Eigen::Vector2d(radius_range_[0], radius_range_[1]);
+    if (radius_option_->count()) o.head_radius_mm = radius_;
+    o.congruent_socket = socket_ == "congruent";
+    o.socket_excess_mm = options_.socket_excess_mm;
+    o.socket_wall_mm = options_.socket_wall_mm;
+    o.fovea = options_.fovea;
+    o.both_hips = options_.both_hips;
+    o.exact_depth = options_.exact_depth;
     if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer");
     o.seed = static_cast<unsigned long long>(common.seed);
     if (!model_.empty()) o.model = geometry::modelFromName(model_);
@@ -67,8 +109,14 @@ class PhantomCommand : public cli::Command {
   std::filesystem::path output_;
   std::string model_, side_ = "right";
   std::vector<double> spacing_ = {0.7, 0.7, 1.5};
-  double gap_ = 3.0, noise_ = 20.0, blur_ = 0.5;
-  bool ras_ = false, no_dicom_ = false;
+  double gap_ = 3.0, noise_ = 20.0, blur_ = 0.5, radius_ = 0;
+  bool ras_ = false, no_dicom_ = false, osteoporotic_ = false;
+  std::vector<double> radius_range_ = {20.0, 25.0};
+  std::string socket_ = "congruent";
+  double socket_cortical_hu_ = 0, socket_cancellous_hu_ = 0;
+  phantom::PhantomOptions options_;  // holds the parsed values of the bone and socket options
+  CLI::Option *radius_option_ = nullptr, *cortical_hu_ = nullptr, *cancellous_hu_ = nullptr, *cortical_mm_ = nullptr, *variation_ = nullptr,
+              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr;
 };
 
 ARTICULA_REGISTER_COMMAND(PhantomCommand)

@@ -33,3 +33,17 @@ cmp "$T/points.ply" "$T/again.ply"
 # CSV output by --format.
 "$B/articula-sample" -i "$T/head.vtp" -o "$T/points.ply" --format csv --seed 1 -q --force
 head -1 "$T/points.csv" | grep -q x_mm
+# The wider phantom's options reach truth.json: both hips, a fixed radius, a
+# spherical socket, a fovea, osteoporotic bone.
+"$B/articula" phantom -o "$T/pelvis" --both-hips --side left --radius 18 --socket spherical --fovea --osteoporotic \
+  --gap 1.5 --spacing 3,3,3 --no-dicom -q
+python3 - "$T/pelvis/truth.json" <<'PY'
+import json, math, sys
+t = json.load(open(sys.argv[1]))
+assert t["both_hips"] and [h["side"] for h in t["hips"]] == ["left", "right"], t["hips"]
+assert t["side"] == "left" and t["head_center_mm"] == t["hips"][0]["head_center_mm"]
+assert 170 < math.dist(t["hips"][0]["head_center_mm"], t["hips"][1]["head_center_mm"]) < 200
+assert t["socket"]["shape"] == "spherical" and "fovea" in t["hips"][1]
+assert t["cortical_mm"] == 0.8 and t["hu"]["cancellous"] == 190 and t["joint_gap_mm"] == 1.5
+PY
+"$B/articula" phantom -o "$T/bad" --radius 60 -q 2>/dev/null && exit 1 || test $? -eq 2

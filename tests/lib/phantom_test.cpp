@@ -1,10 +1,14 @@
 // Phantom: tissues where the truth puts them, the model varied by seed, the
-// femur truth label, and deterministic output.
+// femur truth label, and deterministic output; the options of the wider
+// phantom (radius, gap, socket, osteoporotic bone, fovea, both hips) checked
+// voxel by voxel against the exact distance to the true head.
+#include <cmath>
 #include <set>
 
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
+#include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/surface.hpp"
 #include "articula/phantom/phantom.hpp"
 
@@ -57,6 +61,246 @@ TEST(Phantom, SeedsVaryTheModelAndRepeatExactly) {
   o.right = false;
   EXPECT_GT(phantom::makePhantom(o).head.center[0], 0.0);  // left hip: +x in LPS
   o.gap_mm = 0;
+  EXPECT_THROW(phantom::makePhantom(o), UsageError);
+}
+
+Eigen::Vector3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
+
+phantom::PhantomOptions clean(unsigned long long seed) {
+  phantom::PhantomOptions o;
+  o.seed = seed;
+  o.noise_hu = 0;
+  o.blur_mm = 0;  // every voxel away from an interface holds its tissue's HU exactly
+  o.exact_depth = true;
+  o.spacing = Eigen::Vector3d(1.0, 1.0, 1.0);
+  return o;
+}
+
+// Every voxel centre of a noise- and blur-free phantom whose distance to the
+// nearest tissue boundary exceeds half the voxel diagonal (no partial volume)
+// holds the HU of the tissue the exact signed distance d to the true head
+// (less the fovea) puts it in: cancellous below the cortex, cortex, the gap's
+// soft tissue for 0 < d < gap, the socket's cortex at the gap from the head
+// (congruent socket, within its cone); and the femur label is 1 exactly where d < 0 near the head.
+void expectTissuesFollowTheExactSurface(const phantom::PhantomOptions& o) {
+  const phantom::Phantom p = phantom::makePhantom(o);
+  const phantom::Hip& hip = p.hips[0];
+  const distance::SignedDistance exact(hip.head);
+  const imaging::ImageGeometry& g = p.ct.geometry;
+  const double hd = 0.5 * g.spacing.norm() + 1e-6, cortex = o.cortical_mm, gap = o.gap_mm;
+  const double r = hip.head.radii.maxCoeff();
+  int checked[4] = {0, 0, 0, 0};
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const Eigen::Vector3d x = g.toPhysical(Eigen::Vector3d(i, j, k));
+        const Eigen::Vector3d u = x - hip.head.center;
+        if (u.norm() > r + gap + 4.0) continue;
+        // Only the cap facing the socket: away from the neck and within the socket's cone.
+        if (u.normalized().dot(hip.socket_axis) < std::cos(60.0 * M_PI / 180.0)) continue;
+        const double dh = exact.closest(x).distance;  // to the head; the socket follows it
+        const double d = phantom::headSurfaceDistance(hip, dh, x);  // to the head less the pit
+        const float hu = p.ct.at(i, j, k);
+        EXPECT_EQ(p.femur.at(i, j, k), d < 0 ? 1 : 0) << "d " << d;
+        if (d < -cortex - hd && d > -cortex - 3.0) {
+          if (o.cancellous_variation_hu == 0) {
+            EXPECT_FLOAT_EQ(hu, float(o.cancellous_hu)) << "d " << d;
+          } else {
+            EXPECT_LE(std::fabs(hu - o.cancellous_hu), o.cancellous_variation_hu + 1e-3) << "d " << d;
+          }
+          ++checked[0];
+        } else if (d > -cortex + hd && d < -hd) {
+          EXPECT_FLOAT_EQ(hu, float(o.cortical_hu)) << "d " << d;
+          ++checked[1];
+        } else if (d > hd && dh < gap - hd) {
+          EXPECT_FLOAT_EQ(hu, float(o.soft_tissue_hu)) << "d " << d;
+          ++checked[2];
+        } else if (o.congruent_socket && dh > gap + hd && dh < gap + cortex - hd) {
+          EXPECT_FLOAT_EQ(hu, float(o.socket_cortical_hu.value_or(o.cortical_hu))) << "d " << d;
+          ++checked[3];
+        }
+      }
+  // Each tissue was actually met (the cortex and the socket's only where thicker than a voxel).
+  EXPECT_GT(checked[0], 100);
+  EXPECT_GT(checked[2], 100);
+  if (cortex > 2 * hd) {
+    EXPECT_GT(checked[1], 100);
+  }
+  if (o.congruent_socket && cortex > 2 * hd) {
+    EXPECT_GT(checked[3], 100);
+  }
+}
+
+TEST(Phantom, TissuesFollowTheExactHeadSurface) {
+  phantom::PhantomOptions o = clean(4);
+  o.model = geometry::ShapeModel::Superovoid;
+  o.gap_mm = 3.0;
+  o.cortical_mm = 2.5;  // thicker than the 1 mm voxels' diagonal, so pure cortex voxels exist
+  expectTissuesFollowTheExactSurface(o);
+}
+
+TEST(Phantom, NarrowGapSmallHeadWithFovea) {
+  phantom::PhantomOptions o = clean(6);
+  o.spacing = Eigen::Vector3d(0.6, 0.6, 0.6);
+  o.model = geometry::ShapeModel::Superellipsoid;
+  o.gap_mm = 1.5;
+  o.head_radius_mm = 17.0;
+  o.fovea = true;
+  expectTissuesFollowTheExactSurface(o);
+}
+
+TEST(Phantom, OsteoporoticBoneInASphericalSocket) {
+  phantom::PhantomOptions o = clean(7);
+  o.model = geometry::ShapeModel::Ellipsoid;
+  o.makeOsteoporotic();
+  o.congruent_socket = false;
+  o.head_radius_range_mm = Eigen::Vector2d(17, 30);
+  expectTissuesFollowTheExactSurface(o);
+  const phantom::Phantom p = phantom::makePhantom(o);
+  // Cancellous HU below 200 in places and above in others; the faint cortex.
+  float lowest = 1e9f, highest = -1e9f;
+  for (float v : p.ct.voxels) lowest = std::min(lowest, v), highest = std::max(highest, v);
+  EXPECT_EQ(highest, 700.0f);
+  int below = 0, above = 0;
+  const imaging::ImageGeometry& g = p.ct.geometry;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        if (p.femur.at(i, j, k) == 1 && p.ct.at(i, j, k) > o.soft_tissue_hu + 1 && p.ct.at(i, j, k) < 699)
+          (p.ct.at(i, j, k) < 200 ? below : above)++;
+  EXPECT_GT(below, 1000);
+  EXPECT_GT(above, 1000);
+  // The spherical socket: its inner sphere is gap_mm beyond the head's bounding sphere at the pole
+  // and wider towards the rim, as truth.json says.
+  const phantom::Hip& hip = p.hips[0];
+  const double r = hip.head.radii.maxCoeff();
+  EXPECT_NEAR(p.truth["socket"]["inner_radius_mm"].get<double>(), r + o.gap_mm + o.socket_excess_mm, 1e-12);
+  EXPECT_NEAR((hip.socket_center - hip.head.center).norm(), o.socket_excess_mm, 1e-12);
+  EXPECT_GE(r, 17.0 * 0.94);
+  EXPECT_LE(r, 30.0 * 1.06);
+}
+
+// The joint gap along rays from a sphere's centre within the socket's cone,
+// measured on the CT (blur-free, partial volume by supersampling) as the
+// distance between the two half-way crossings of cortex and soft tissue:
+// the requested gap, congruent or, at the pole of a spherical socket.
+TEST(Phantom, GapAlongRaysIsTheRequestedGap) {
+  for (double gap : {1.5, 4.0}) {
+    phantom::PhantomOptions o = clean(9);
+    o.model = geometry::ShapeModel::Sphere;
+    o.spacing = Eigen::Vector3d(0.6, 0.6, 0.6);
+    o.gap_mm = gap;
+    o.head_radius_mm = 24.0;
+    const phantom::Phantom p = phantom::makePhantom(o);
+    const imaging::ImageGeometry& g = p.ct.geometry;
+    auto trilinear = [&](const Eigen::Vector3d& x) {
+      const Eigen::Vector3d f = g.toIndex(x);
+      const int i = int(std::floor(f[0])), j = int(std::floor(f[1])), k = int(std::floor(f[2]));
+      const double a = f[0] - i, b = f[1] - j, c = f[2] - k;
+      double v = 0;
+      for (int n = 0; n < 8; ++n)
+        v += (n & 1 ? a : 1 - a) * (n & 2 ? b : 1 - b) * (n & 4 ? c : 1 - c) * p.ct.at(i + (n & 1), j + (n >> 1 & 1), k + (n >> 2 & 1));
+      return v;
+    };
+    const double level = 0.5 * (o.cortical_hu + o.soft_tissue_hu);
+    const Eigen::Vector3d axis = p.hips[0].socket_axis;
+    const Eigen::Vector3d side = axis.cross(Eigen::Vector3d::UnitZ()).normalized();
+    for (double tilt : {0.0, 0.3, 0.6}) {
+      const Eigen::Vector3d d = (axis + tilt * side).normalized();
+      auto crossing = [&](double from, double to) {  // where the profile crosses the level, by bisection
+        const bool rising = trilinear(p.head.center + to * d) > level;
+        for (int n = 0; n < 60; ++n) {
+          const double mid = 0.5 * (from + to);
+          ((trilinear(p.head.center + mid * d) > level) == rising ? to : from) = mid;
+        }
+        return 0.5 * (from + to);
+      };
+      const double head = crossing(24.0 - 0.9, 24.0 + 0.5 * gap), socket = crossing(24.0 + 0.5 * gap, 24.0 + gap + 0.9);
+      EXPECT_NEAR(head, 24.0, 0.15) << "gap " << gap << " tilt " << tilt;
+      EXPECT_NEAR(socket - head, gap, 0.2) << "gap " << gap << " tilt " << tilt;
+    }
+  }
+}
+
+TEST(Phantom, FoveaIsAPitOnTheHead) {
+  phantom::PhantomOptions o = clean(11);
+  o.model = geometry::ShapeModel::Sphere;
+  o.head_radius_mm = 22.0;
+  o.fovea = true;
+  const phantom::Phantom p = phantom::makePhantom(o);
+  const phantom::Hip& hip = p.hips[0];
+  ASSERT_TRUE(hip.fovea);
+  const Eigen::Vector3d d = (hip.fovea_center - hip.head.center).normalized();
+  EXPECT_NEAR((hip.fovea_center - hip.head.center).norm(), 22.0 + o.fovea_radius_mm - o.fovea_depth_mm, 1e-6);
+  EXPECT_EQ(vec3(p.truth["fovea"]["center_mm"]), hip.fovea_center);
+  // In the pit: soft tissue where the sphere alone would be cortex; beside it, cortex.
+  const Eigen::Vector3d in_pit = hip.head.center + (22.0 - 0.5 * o.fovea_depth_mm) * d;
+  EXPECT_FLOAT_EQ(huAt(p, in_pit), float(o.soft_tissue_hu));
+  EXPECT_GT(phantom::headSurfaceDistance(hip, -0.5 * o.fovea_depth_mm, in_pit), 0.0);
+  const Eigen::Vector3d away = (d + 0.6 * d.cross(Eigen::Vector3d::UnitZ()).normalized()).normalized();
+  EXPECT_FLOAT_EQ(huAt(p, hip.head.center + 21.3 * away), float(o.cortical_hu));
+  // Below the pit's floor the head is bone again.
+  EXPECT_GT(huAt(p, hip.head.center + (22.0 - o.fovea_depth_mm - 0.8) * d), 1000.0);
+}
+
+TEST(Phantom, BothHipsWhereTheTruthSays) {
+  phantom::PhantomOptions o;
+  o.seed = 12;
+  o.both_hips = true;
+  o.right = false;  // the left head is the top-level truth and label 1
+  o.spacing = Eigen::Vector3d(1.5, 1.5, 3.0);
+  o.ras_storage = true;
+  o.gap_mm = 2.0;
+  o.head_radius_range_mm = Eigen::Vector2d(17, 30);
+  const phantom::Phantom p = phantom::makePhantom(o);
+  ASSERT_EQ(p.hips.size(), 2u);
+  ASSERT_EQ(p.truth["hips"].size(), 2u);
+  EXPECT_FALSE(p.hips[0].right);
+  EXPECT_TRUE(p.hips[1].right);
+  EXPECT_EQ(p.truth["side"], "left");
+  EXPECT_EQ(p.truth["hips"][1]["side"], "right");
+  const Eigen::Vector3d left = vec3(p.truth["hips"][0]["head_center_mm"]), right = vec3(p.truth["hips"][1]["head_center_mm"]);
+  EXPECT_GT(left[0], 80.0);
+  EXPECT_LT(right[0], -80.0);
+  EXPECT_GT((left - right).norm(), 170.0);
+  EXPECT_LT((left - right).norm(), 200.0);
+  for (int n = 0; n < 2; ++n) {
+    const Eigen::Vector3d idx = p.femur.geometry.toIndex(p.hips[n].head.center);
+    const int i = int(std::lround(idx[0])), j = int(std::lround(idx[1])), k = int(std::lround(idx[2]));
+    EXPECT_EQ(p.femur.at(i, j, k), n + 1);
+    EXPECT_NEAR(p.ct.at(i, j, k), o.cancellous_hu, 4 * o.noise_hu);
+  }
+  // The requested side's head is the single-hip phantom's of the same seed.
+  phantom::PhantomOptions single = o;
+  single.both_hips = false;
+  EXPECT_EQ(phantom::makePhantom(single).head.center, p.head.center);
+  // Bone at the midline (sacrum and symphysis), none in a single-hip phantom's field there.
+  const Eigen::Vector3d mid = 0.5 * (left + right);
+  EXPECT_GT(huAt(p, Eigen::Vector3d(0, mid[1] + 65.0, mid[2] + 30.0)), 200.0);
+  EXPECT_GT(huAt(p, Eigen::Vector3d(0, mid[1] - 45.0, mid[2] - 20.0)), 200.0);
+}
+
+TEST(Phantom, RadiusOptions) {
+  phantom::PhantomOptions o;
+  o.spacing = Eigen::Vector3d(3, 3, 3);
+  o.model = geometry::ShapeModel::Sphere;
+  o.head_radius_mm = 17.0;
+  EXPECT_EQ(phantom::makePhantom(o).head.radii[0], 17.0);
+  o.head_radius_mm.reset();
+  o.head_radius_range_mm = Eigen::Vector2d(17, 30);
+  std::set<double> radii;
+  for (unsigned long long seed = 0; seed < 8; ++seed) {
+    o.seed = seed;
+    const double r = phantom::makePhantom(o).head.radii[0];
+    EXPECT_GE(r, 17.0);
+    EXPECT_LE(r, 30.0);
+    radii.insert(std::floor(r / 4.0));
+  }
+  EXPECT_GE(radii.size(), 3u);  // the draws spread over the range
+  o.head_radius_mm = 50.0;
+  EXPECT_THROW(phantom::makePhantom(o), UsageError);
+  o.head_radius_mm.reset();
+  o.head_radius_range_mm = Eigen::Vector2d(30, 17);
   EXPECT_THROW(phantom::makePhantom(o), UsageError);
 }
 

@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <optional>
 #include <random>
 
 #include <Eigen/Geometry>
 
 #include "articula/core/error.hpp"
+#include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
 
@@ -23,18 +28,58 @@ double cylinderDepth(const Vector3d& x, const Vector3d& a, const Vector3d& b, do
   return std::min({radial, t, length - t});
 }
 
-/// The phantom's tissues as a function of position.
-struct Anatomy {
-  std::unique_ptr<geometry::PosedSurface> head;
-  Vector3d center, neck_end, shaft_top, shaft_bottom, trochanter, trochanter_axes, socket_axis;
-  double neck_radius, shaft_radius, gap, socket_wall = 12.0, socket_half_angle_cos;
-  const PhantomOptions* o;
+struct Cylinder {
+  Vector3d a, b;
+  double radius;
+  double depth(const Vector3d& x) const { return cylinderDepth(x, a, b, radius); }
+};
 
-  /// Approximate signed depth below the head surface, -F / |grad F| (exact to
-  /// first order at the surface, which is all the cortex and gap need).
+/// An axis-aligned box: depth below its nearest face (positive inside).
+struct Box {
+  Vector3d center, half;
+  double depth(const Vector3d& x) const { return (half - (x - center).cwiseAbs()).minCoeff(); }
+};
+
+/// One hip's tissues as functions of position.
+struct HipAnatomy {
+  Hip truth;
+  std::unique_ptr<geometry::PosedSurface> head;
+  std::unique_ptr<distance::SignedDistance> exact;
+  Vector3d center, neck_end, shaft_top, shaft_bottom, trochanter, trochanter_axes;
+  double r0 = 0, rmax = 0, neck_radius = 0, shaft_radius = 14.0;  // r0: the drawn mean radius
+  // Approximate depths in [band_lo, band_hi] are replaced by the exact one;
+  // beyond max_reach from the centre no tissue boundary depends on it.
+  double band_lo = 0, band_hi = 0, max_reach = 0;
+  bool exact_depth = false;
+  mutable std::optional<Vector3d> last_foot;  // the previous exact closest point
+  mutable Vector3d last_x = Vector3d::Zero();  // and its point
+
+  /// Signed depth below the head surface (positive inside, mm): -F / |grad F|,
+  /// exact to first order at the surface and of the right sign; with
+  /// exact_depth, exact within the band where the cortex, the gap and the
+  /// socket are drawn.
   double headDepth(const Vector3d& x) const {
+    if ((x - center).norm() > max_reach) return rmax - (x - center).norm();
     const geometry::Evaluation e = head->evaluate(x, 1);
-    return -e.value / std::max(e.gradient.norm(), 1e-9);
+    const double approx = -e.value / std::max(e.gradient.norm(), 1e-9);
+    if (!exact_depth || approx < band_lo || approx > band_hi) return approx;
+    // Voxels are visited in order, so the previous foot point is a good start
+    // for a local search when the previous point was near. Newton can also
+    // land on a farther critical point, so its answer is kept only if it is
+    // no farther than the start (a surface point) and of the sign of F.
+    if (last_foot && (x - last_x).norm() < 3.0) {
+      const distance::ClosestPoint c = exact->closestFrom(x, *last_foot);
+      if (std::fabs(c.distance) <= (x - *last_foot).norm() + 1e-9 && (c.distance < 0) == (e.value < 0) &&
+          (c.point - *last_foot).norm() < 3.0) {
+        last_x = x;
+        last_foot = c.point;
+        return -c.distance;
+      }
+    }
+    const distance::ClosestPoint c = exact->closest(x);
+    last_x = x;
+    last_foot = c.point;
+    return -c.distance;
   }
 
   /// Approximate signed depth inside the greater trochanter: an elongated
@@ -47,25 +92,70 @@ struct Anatomy {
     return (1.0 - q) / grad.norm();
   }
 
-  /// Signed depth inside the femur: head, neck, shaft and trochanter.
-  double femurDepth(const Vector3d& x) const {
-    return std::max({headDepth(x), cylinderDepth(x, center, neck_end, neck_radius),
+  /// Signed depth inside the femur (head less the fovea, neck, shaft,
+  /// trochanter), given the head depth at x.
+  double femurDepth(const Vector3d& x, double head_depth) const {
+    return std::max({-headSurfaceDistance(truth, -head_depth, x), cylinderDepth(x, center, neck_end, neck_radius),
                      cylinderDepth(x, shaft_top, shaft_bottom, shaft_radius), trochanterDepth(x)});
   }
+};
 
-  /// HU at x and the distance to the nearest tissue interface (mm).
-  double hu(const Vector3d& x, double& interface) const {
-    const double femur = femurDepth(x);
-    // The acetabulum: a shell from gap to gap + wall outside the head, within a cone about the socket axis.
-    const double outside = -headDepth(x);
-    const Vector3d u = (x - center).normalized();
-    const double cone = ((x - center).norm()) * (u.dot(socket_axis) - socket_half_angle_cos);
-    const double socket = std::min({outside - gap, gap + socket_wall - outside, cone});
-    interface = std::min({std::fabs(femur), std::fabs(femur - o->cortical_mm), std::fabs(socket),
-                          std::fabs(socket - o->cortical_mm)});
-    const double bone = std::max(femur, socket);
+/// The whole field of view: the hips, their sockets and the pelvic frame.
+struct Anatomy {
+  std::vector<HipAnatomy> hips;
+  std::vector<Cylinder> pelvis_bars;  // ilium and pubic rami (both hips)
+  std::vector<Box> pelvis_blocks;     // sacrum and pubic symphysis (both hips)
+  double socket_half_angle_cos = std::cos(80.0 * M_PI / 180.0);
+  Vector3d wave_phase = Vector3d::Zero();
+  const PhantomOptions* o = nullptr;
+
+  /// Depth inside a hip's acetabulum: a shell of the wall's thickness,
+  /// congruent (at the gap from the head) or spherical, within a cone of
+  /// 80 degrees about the socket axis.
+  double socketDepth(const HipAnatomy& h, const Vector3d& x, double head_depth) const {
+    const Vector3d from_pole_centre = x - h.truth.socket_center;
+    const double r = from_pole_centre.norm();
+    const double cone = r * (from_pole_centre.dot(h.truth.socket_axis) / std::max(r, 1e-12) - socket_half_angle_cos);
+    if (o->congruent_socket) {
+      const double outside = -head_depth;
+      return std::min({outside - o->gap_mm, o->gap_mm + o->socket_wall_mm - outside, cone});
+    }
+    const double inner = h.truth.socket_inner_radius_mm;
+    return std::min({r - inner, inner + o->socket_wall_mm - r, cone});
+  }
+
+  /// Cancellous HU at x: uniform, or varying smoothly (wavelength 30 mm).
+  double cancellous(double base, const Vector3d& x) const {
+    if (o->cancellous_variation_hu <= 0) return base;
+    const Vector3d w = x * (2.0 * M_PI / 30.0) + wave_phase;
+    return base + o->cancellous_variation_hu * std::sin(w[0]) * std::sin(w[1]) * std::sin(w[2]);
+  }
+
+  /// HU at x and the distance to the nearest tissue interface (mm); `femur`
+  /// gets the label of the femur containing x (0: none).
+  double hu(const Vector3d& x, double& interface, int* femur_label = nullptr) const {
+    double femur = -std::numeric_limits<double>::infinity(), pelvis = femur, clearance = -femur;
+    for (size_t n = 0; n < hips.size(); ++n) {
+      const HipAnatomy& h = hips[n];
+      const double head_depth = h.headDepth(x);
+      const double f = h.femurDepth(x, head_depth);
+      if (f > femur) {
+        femur = f;
+        if (femur_label) *femur_label = f > 0 ? static_cast<int>(n) + 1 : 0;
+      }
+      pelvis = std::max(pelvis, socketDepth(h, x, head_depth));
+      clearance = std::min(clearance, (x - h.center).norm() - h.rmax - o->gap_mm - 1.0);
+    }
+    // The frame keeps clear of the joints (the sockets alone face the heads).
+    for (const Cylinder& c : pelvis_bars) pelvis = std::max(pelvis, std::min(c.depth(x), clearance));
+    for (const Box& b : pelvis_blocks) pelvis = std::max(pelvis, std::min(b.depth(x), clearance));
+    const double cortex = o->cortical_mm;
+    interface = std::min({std::fabs(femur), std::fabs(femur - cortex), std::fabs(pelvis), std::fabs(pelvis - cortex)});
+    const double bone = std::max(femur, pelvis);
     if (bone <= 0) return o->soft_tissue_hu;
-    return bone < o->cortical_mm ? o->cortical_hu : o->cancellous_hu;
+    if (femur >= pelvis) return bone < cortex ? o->cortical_hu : cancellous(o->cancellous_hu, x);
+    return bone < cortex ? o->socket_cortical_hu.value_or(o->cortical_hu)
+                         : cancellous(o->socket_cancellous_hu.value_or(o->cancellous_hu), x);
   }
 };
 
@@ -99,26 +189,14 @@ void blur(imaging::Volume& v, double sigma_mm) {
 
 nlohmann::json vec(const Vector3d& v) { return {v[0], v[1], v[2]}; }
 
-}  // namespace
-
-void PhantomOptions::validate() const {
-  if (!(spacing.minCoeff() >= 0.2 && spacing.maxCoeff() <= 4.0))
-    throw UsageError("phantom spacing: expected 0.2 to 4 mm per axis");
-  if (!(gap_mm >= 0.5 && gap_mm <= 8.0)) throw UsageError("phantom --gap: expected 0.5 to 8 mm");
-  if (!(noise_hu >= 0) || !(blur_mm >= 0)) throw UsageError("phantom noise and blur must be >= 0");
-  if (!(cortical_mm > 0)) throw UsageError("phantom cortical thickness must be > 0");
-}
-
-Phantom makePhantom(const PhantomOptions& o) {
-  o.validate();
-  std::mt19937_64 rng(o.seed);
-  auto uniform = [&rng](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
-  const double s = o.right ? -1.0 : 1.0;  // LPS: the right side is -x; lateral is s * x
-
-  // The head: a member of the hierarchy, near-spherical like real femoral heads.
+/// Draws one head (the order of draws is that of the original single-hip
+/// phantom, so a seed keeps its head).
+geometry::ShapeParameters drawHead(const PhantomOptions& o, geometry::ShapeModel model, double s,
+                                   const std::function<double(double, double)>& uniform, double& r0) {
   geometry::ShapeParameters p;
-  p.model = o.model ? *o.model : geometry::allModels()[o.seed % geometry::allModels().size()];
-  const double r0 = uniform(20.0, 25.0);
+  p.model = model;
+  r0 = uniform(o.head_radius_range_mm[0], o.head_radius_range_mm[1]);
+  if (o.head_radius_mm) r0 = *o.head_radius_mm;
   p.radii = Vector3d::Constant(r0);
   if (p.model != geometry::ShapeModel::Sphere)
     p.radii = Vector3d(r0 * uniform(0.94, 1.06), r0 * uniform(0.94, 1.06), r0 * uniform(0.94, 1.06));
@@ -132,29 +210,169 @@ Phantom makePhantom(const PhantomOptions& o) {
   if (p.model != geometry::ShapeModel::Sphere)
     p.angles = Vector3d(uniform(-0.3, 0.3), uniform(-0.3, 0.3), uniform(-0.3, 0.3));
   geometry::validate(p);
+  return p;
+}
 
-  Anatomy a;
-  a.o = &o;
-  a.head = geometry::makeSurface(p);
-  a.center = p.center;
-  const double rmax = p.radii.maxCoeff();
+/// Distance from the centre to the surface along unit direction d (bisection on F).
+double surfaceAlong(const geometry::PosedSurface& head, const Vector3d& center, const Vector3d& d, double rmax) {
+  double lo = 0, hi = 2 * rmax;
+  while (hi - lo > 1e-9) (head.value(center + 0.5 * (lo + hi) * d) < 0 ? lo : hi) = 0.5 * (lo + hi);
+  return 0.5 * (lo + hi);
+}
+
+/// The hip's femur and socket around a drawn head.
+HipAnatomy makeHip(const PhantomOptions& o, const geometry::ShapeParameters& p, double r0, bool right) {
+  const double s = right ? -1.0 : 1.0;  // LPS: the right side is -x; lateral is s * x
+  HipAnatomy h;
+  h.truth.right = right;
+  h.truth.head = p;
+  h.head = geometry::makeSurface(p);
+  h.exact = std::make_unique<distance::SignedDistance>(p);
+  h.center = p.center;
+  h.rmax = p.radii.maxCoeff();
+  h.r0 = r0;
   // Neck: lateral, inferior and a little anterior (LPS: anterior is -y).
   const Vector3d neck_axis = Vector3d(s * 1.0, -0.25, -0.8).normalized();
-  a.neck_radius = 0.68 * r0;
-  a.neck_end = a.center + 1.9 * r0 * neck_axis;
-  a.shaft_radius = 14.0;
-  a.shaft_top = a.neck_end + Vector3d(s * 6.0, 0.0, 10.0);
-  a.shaft_bottom = a.shaft_top - Vector3d(0, 0, 400.0);
-  a.trochanter = a.shaft_top + Vector3d(s * 4.0, 0.0, 0.0);
-  a.trochanter_axes = Vector3d(13.0, 15.0, 20.0);  // lateral, anterior-posterior, vertical (mm)
-  a.socket_axis = (-neck_axis + Vector3d(0, 0, 0.3)).normalized();
-  a.socket_half_angle_cos = std::cos(80.0 * M_PI / 180.0);
-  a.gap = o.gap_mm;
+  h.truth.neck_axis = neck_axis;
+  h.neck_radius = 0.68 * r0;
+  h.neck_end = h.center + 1.9 * r0 * neck_axis;
+  h.shaft_top = h.neck_end + Vector3d(s * 6.0, 0.0, 10.0);
+  h.shaft_bottom = h.shaft_top - Vector3d(0, 0, 400.0);
+  h.trochanter = h.shaft_top + Vector3d(s * 4.0, 0.0, 0.0);
+  h.trochanter_axes = Vector3d(13.0, 15.0, 20.0);  // lateral, anterior-posterior, vertical (mm)
+  h.truth.socket_axis = (-neck_axis + Vector3d(0, 0, 0.3)).normalized();
+  h.truth.socket_center = h.center;
+  if (!o.congruent_socket) {
+    // The pole of the socket lies gap_mm beyond the head's bounding sphere,
+    // so the joint space is gap_mm at least and widens towards the rim.
+    h.truth.socket_inner_radius_mm = h.rmax + o.gap_mm + o.socket_excess_mm;
+    h.truth.socket_center = h.center - o.socket_excess_mm * h.truth.socket_axis;
+  }
+  if (o.fovea) {
+    const Vector3d d = Vector3d(-s, 0.15, -0.2).normalized();  // medial, a little posterior and inferior
+    const double t = surfaceAlong(*h.head, h.center, d, h.rmax);
+    h.truth.fovea = true;
+    h.truth.fovea_radius_mm = o.fovea_radius_mm;
+    h.truth.fovea_center = h.center + (t + o.fovea_radius_mm - o.fovea_depth_mm) * d;
+  }
+  const double outer = o.gap_mm + o.socket_wall_mm + (o.congruent_socket ? 0.0 : o.socket_excess_mm);
+  h.band_lo = -1.5 * outer - 3.0;
+  h.band_hi = 1.5 * (o.cortical_mm + (o.fovea ? o.fovea_depth_mm : 0.0)) + 3.0;
+  h.max_reach = h.rmax + 1.5 * outer + 10.0;
+  h.exact_depth = o.exact_depth;
+  return h;
+}
+
+nlohmann::json hipTruth(const Hip& hip, const PhantomOptions& o) {
+  const geometry::ShapeParameters& p = hip.head;
+  nlohmann::json lambda;
+  const auto names = geometry::parameterNames(p.model);
+  const Eigen::VectorXd values = geometry::toVector(p);
+  for (size_t n = 0; n < names.size(); ++n) lambda[names[n]] = values[static_cast<Eigen::Index>(n)];
+  nlohmann::json t = {
+      {"side", hip.right ? "right" : "left"},
+      {"model", geometry::modelName(p.model)},
+      {"parameters", lambda},
+      {"radii_mm", vec(p.radii)},
+      {"exponents", vec(p.exponents)},
+      {"cx", {p.cx[0], p.cx[1], p.cx[2], p.cx[3]}},
+      {"cy", {p.cy[0], p.cy[1], p.cy[2], p.cy[3]}},
+      {"angles_rad", vec(p.angles)},
+      {"head_center_mm", vec(p.center)},
+      {"head_max_radius_mm", p.radii.maxCoeff()},
+      {"neck_axis", vec(hip.neck_axis)},
+      {"socket_axis", vec(hip.socket_axis)},
+      {"socket",
+       {{"shape", o.congruent_socket ? "congruent" : "spherical"},
+        {"wall_mm", o.socket_wall_mm},
+        {"center_mm", vec(hip.socket_center)},
+        {"inner_radius_mm", hip.socket_inner_radius_mm}}},
+  };
+  if (hip.fovea)
+    t["fovea"] = {{"center_mm", vec(hip.fovea_center)}, {"radius_mm", hip.fovea_radius_mm}, {"depth_mm", o.fovea_depth_mm}};
+  return t;
+}
+
+}  // namespace
+
+double headSurfaceDistance(const Hip& hip, double head_distance_mm, const Eigen::Vector3d& x) {
+  if (!hip.fovea) return head_distance_mm;
+  // The head less the pit's ball: max(d_head, -d_ball), exact away from the pit's rim.
+  return std::max(head_distance_mm, hip.fovea_radius_mm - (x - hip.fovea_center).norm());
+}
+
+void PhantomOptions::makeOsteoporotic() {
+  cortical_mm = 0.8;
+  cortical_hu = 700;
+  cancellous_hu = 190;
+  cancellous_variation_hu = 90;
+}
+
+void PhantomOptions::validate() const {
+  if (!(spacing.minCoeff() >= 0.2 && spacing.maxCoeff() <= 4.0))
+    throw UsageError("phantom spacing: expected 0.2 to 4 mm per axis");
+  if (!(gap_mm >= 0.5 && gap_mm <= 8.0)) throw UsageError("phantom --gap: expected 0.5 to 8 mm");
+  if (!(noise_hu >= 0) || !(blur_mm >= 0)) throw UsageError("phantom noise and blur must be >= 0");
+  if (!(cortical_mm > 0 && cortical_mm <= 5)) throw UsageError("phantom cortical thickness: expected > 0 and <= 5 mm");
+  if (!(cancellous_variation_hu >= 0)) throw UsageError("phantom cancellous variation: expected >= 0 HU");
+  if (!(head_radius_range_mm[0] >= 10 && head_radius_range_mm[1] <= 40 && head_radius_range_mm[0] <= head_radius_range_mm[1]))
+    throw UsageError("phantom --radius-range: expected 10 <= LO <= HI <= 40 mm");
+  if (head_radius_mm && !(*head_radius_mm >= 10 && *head_radius_mm <= 40))
+    throw UsageError("phantom --radius: expected 10 to 40 mm");
+  if (!(socket_wall_mm >= 2 && socket_wall_mm <= 30)) throw UsageError("phantom --socket-wall: expected 2 to 30 mm");
+  if (!(socket_excess_mm >= 0 && socket_excess_mm <= 15)) throw UsageError("phantom --socket-excess: expected 0 to 15 mm");
+  if (!(fovea_radius_mm > 0 && fovea_depth_mm > 0 && fovea_depth_mm < fovea_radius_mm && fovea_radius_mm <= 10))
+    throw UsageError("phantom fovea: expected 0 < depth < radius <= 10 mm");
+}
+
+Phantom makePhantom(const PhantomOptions& o) {
+  o.validate();
+  std::mt19937_64 rng(o.seed);
+  const std::function<double(double, double)> uniform = [&rng](double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(rng);
+  };
+  const auto& models = geometry::allModels();
+
+  // The requested side first (its head is the single-hip phantom's), then the other.
+  Anatomy a;
+  a.o = &o;
+  std::vector<bool> sides = {o.right};
+  if (o.both_hips) sides.push_back(!o.right);
+  for (size_t n = 0; n < sides.size(); ++n) {
+    const geometry::ShapeModel model = o.model ? *o.model : models[(o.seed + n) % models.size()];
+    double r0 = 0;
+    const geometry::ShapeParameters head = drawHead(o, model, sides[n] ? -1.0 : 1.0, uniform, r0);
+    a.hips.push_back(makeHip(o, head, r0, sides[n]));
+  }
+  if (o.cancellous_variation_hu > 0) a.wave_phase = Vector3d(uniform(0, 2 * M_PI), uniform(0, 2 * M_PI), uniform(0, 2 * M_PI));
 
   // The grid: head, socket and pelvis medially, neck and shaft laterally.
-  // Lateral 60 mm, medial 80 mm: the head lies on its side of the grid's centre.
-  const Vector3d lo(std::min(a.center[0] + s * 60.0, a.center[0] - s * 80.0), a.center[1] - 55.0, a.center[2] - 75.0);
-  const Vector3d hi(std::max(a.center[0] + s * 60.0, a.center[0] - s * 80.0), a.center[1] + 55.0, a.center[2] + 50.0);
+  // Lateral 60 mm (more for heads above 25 mm, whose necks are longer),
+  // medial 80 mm: a single head lies on its side of the grid's centre.
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const HipAnatomy& h : a.hips) {
+    const double s = h.truth.right ? -1.0 : 1.0;
+    const double lateral = 60.0 + std::max(0.0, 1.9 * (h.r0 - 25.0) * 0.8);
+    const Vector3d c = h.center;
+    lo = lo.cwiseMin(Vector3d(std::min(c[0] + s * lateral, c[0] - s * 80.0), c[1] - 55.0, c[2] - 75.0));
+    hi = hi.cwiseMax(Vector3d(std::max(c[0] + s * lateral, c[0] - s * 80.0), c[1] + 55.0, c[2] + 50.0));
+  }
+  if (o.both_hips) {
+    // A pelvis-like frame: each socket joins the sacrum by an ilium (superior,
+    // posterior) and the pubic symphysis by a pubic ramus (medial, anterior).
+    const Vector3d mid = 0.5 * (a.hips[0].center + a.hips[1].center);
+    a.pelvis_blocks.push_back({Vector3d(0, mid[1] + 65.0, mid[2] + 30.0), Vector3d(40, 15, 45)});  // sacrum
+    a.pelvis_blocks.push_back({Vector3d(0, mid[1] - 45.0, mid[2] - 20.0), Vector3d(9, 8, 22)});    // symphysis
+    for (const HipAnatomy& h : a.hips) {
+      const double s = h.truth.right ? -1.0 : 1.0;
+      const double at = h.rmax + o.gap_mm + 0.6 * o.socket_wall_mm;
+      a.pelvis_bars.push_back({h.center + at * Vector3d(0, 0.3, 1).normalized(),
+                               Vector3d(s * 38.0, mid[1] + 58.0, mid[2] + 45.0), 12.0});  // ilium
+      a.pelvis_bars.push_back({h.center + at * Vector3d(-s * 0.85, -0.45, -0.2).normalized(),
+                               Vector3d(s * 6.0, mid[1] - 45.0, mid[2] - 20.0), 8.0});   // pubic ramus
+    }
+    hi[1] = std::max(hi[1], mid[1] + 82.0);
+  }
   imaging::ImageGeometry g;
   g.spacing = o.spacing;
   for (int ax = 0; ax < 3; ++ax) g.size[ax] = static_cast<int>(std::ceil((hi[ax] - lo[ax]) / o.spacing[ax])) + 1;
@@ -167,8 +385,9 @@ Phantom makePhantom(const PhantomOptions& o) {
   }
 
   Phantom out;
-  out.head = p;
-  out.neck_axis = neck_axis;
+  for (const HipAnatomy& h : a.hips) out.hips.push_back(h.truth);
+  out.head = out.hips[0].head;
+  out.neck_axis = out.hips[0].neck_axis;
   out.ct.geometry = g;
   out.ct.voxels.resize(static_cast<size_t>(g.voxelCount()));
   out.femur.geometry = g;
@@ -180,7 +399,8 @@ Phantom makePhantom(const PhantomOptions& o) {
       for (int i = 0; i < g.size[0]; ++i) {
         const Vector3d x = g.toPhysical(Vector3d(i, j, k));
         double interface = 0;
-        double value = a.hu(x, interface);
+        int label = 0;
+        double value = a.hu(x, interface, &label);
         if (interface < half_diagonal) {
           value = 0;
           double ignored = 0;
@@ -191,37 +411,32 @@ Phantom makePhantom(const PhantomOptions& o) {
           value /= sub * sub * sub;
         }
         out.ct.at(i, j, k) = static_cast<float>(value);
-        out.femur.at(i, j, k) = a.femurDepth(x) > 0 ? 1 : 0;
+        out.femur.at(i, j, k) = static_cast<std::uint8_t>(label);
       }
   blur(out.ct, o.blur_mm);
   std::normal_distribution<double> noise(0.0, o.noise_hu);
   if (o.noise_hu > 0)
     for (float& v : out.ct.voxels) v += static_cast<float>(noise(rng));
 
-  nlohmann::json lambda;
-  const auto names = geometry::parameterNames(p.model);
-  const Eigen::VectorXd values = geometry::toVector(p);
-  for (size_t n = 0; n < names.size(); ++n) lambda[names[n]] = values[static_cast<Eigen::Index>(n)];
-  out.truth = {
+  // Top level: the requested side's head, as in the single-hip phantom; `hips`: every head.
+  out.truth = hipTruth(out.hips[0], o);
+  out.truth["hips"] = nlohmann::json::array();
+  for (const Hip& h : out.hips) out.truth["hips"].push_back(hipTruth(h, o));
+  out.truth.update({
       {"coordinate_system", "LPS"},
       {"units", "mm"},
       {"seed", o.seed},
-      {"side", o.right ? "right" : "left"},
       {"joint", "hip"},
-      {"model", geometry::modelName(p.model)},
-      {"parameters", lambda},
-      {"radii_mm", vec(p.radii)},
-      {"exponents", vec(p.exponents)},
-      {"cx", {p.cx[0], p.cx[1], p.cx[2], p.cx[3]}},
-      {"cy", {p.cy[0], p.cy[1], p.cy[2], p.cy[3]}},
-      {"angles_rad", vec(p.angles)},
-      {"head_center_mm", vec(p.center)},
-      {"head_max_radius_mm", rmax},
-      {"neck_axis", vec(neck_axis)},
-      {"socket_axis", vec(a.socket_axis)},
+      {"both_hips", o.both_hips},
       {"joint_gap_mm", o.gap_mm},
       {"cortical_mm", o.cortical_mm},
-      {"hu", {{"cortical", o.cortical_hu}, {"cancellous", o.cancellous_hu}, {"soft_tissue", o.soft_tissue_hu}}},
+      {"hu",
+       {{"cortical", o.cortical_hu},
+        {"cancellous", o.cancellous_hu},
+        {"cancellous_variation", o.cancellous_variation_hu},
+        {"soft_tissue", o.soft_tissue_hu},
+        {"socket_cortical", o.socket_cortical_hu.value_or(o.cortical_hu)},
+        {"socket_cancellous", o.socket_cancellous_hu.value_or(o.cancellous_hu)}}},
       {"noise_hu", o.noise_hu},
       {"blur_mm", o.blur_mm},
       {"grid",
@@ -231,7 +446,7 @@ Phantom makePhantom(const PhantomOptions& o) {
         {"direction_row_major",
          {g.direction(0, 0), g.direction(0, 1), g.direction(0, 2), g.direction(1, 0), g.direction(1, 1),
           g.direction(1, 2), g.direction(2, 0), g.direction(2, 1), g.direction(2, 2)}}}},
-  };
+  });
   return out;
 }
 

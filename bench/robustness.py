@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""Robustness benchmark: `articula run` over a matrix of phantom heads, each
+scored against its truth. See bench/robustness.sh for the usage."""
+import argparse
+import concurrent.futures as futures
+import json
+import os
+import random
+import statistics
+import subprocess
+import sys
+import time
+
+MODELS = ["sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid"]
+# Spacing groups (mm): the 0.6-0.8 group cycles through its members.
+GROUPS = [
+    ("0.6-0.8", [(0.6, 0.6, 0.6), (0.7, 0.7, 0.7), (0.8, 0.8, 0.8), (0.7, 0.7, 0.8)]),
+    ("1x1x1.25", [(1.0, 1.0, 1.25)]),
+    ("1x1x2", [(1.0, 1.0, 2.0)]),
+    ("1.5x1.5x3", [(1.5, 1.5, 3.0)]),
+]
+
+
+def matrix(quick):
+    """CT phantoms, each with the sides to run: 12 single-hip CTs and 2
+    both-hips CTs (both sides run) per spacing group, 64 heads in all."""
+    cts = []
+    for g, (group, spacings) in enumerate(GROUPS):
+        for i in range(12):
+            rng = random.Random(1000 * g + i)
+            side = "right" if i % 2 == 0 else "left"
+            cts.append(dict(
+                id=f"g{g}-{i:02d}", group=group, spacing=spacings[i % len(spacings)], seed=100 * g + i + 1,
+                model=MODELS[(i + g) % 5], sides=[side], both=False,
+                dicom=i % 3 == 0, ras=i % 4 in (1, 2),
+                gap=rng.choice([1.5, 2.0, 2.5, 3.0, 4.0, 5.0]), radius=round(rng.uniform(17, 30), 1),
+                socket="spherical" if rng.random() < 0.3 else "congruent",
+                osteoporotic=rng.random() < 0.3, fovea=rng.random() < 0.5))
+        for b in range(2):
+            rng = random.Random(1000 * g + 50 + b)
+            sp = spacings[-1] if group == "0.6-0.8" else spacings[0]  # the coarsest member: a wide field of view
+            cts.append(dict(
+                id=f"g{g}-pelvis{b}", group=group, spacing=sp, seed=100 * g + 50 + b, model=None,
+                sides=["right", "left"], both=True, dicom=b == 1, ras=b == 1,
+                gap=rng.choice([1.5, 2.0, 2.5, 3.0, 4.0, 5.0]), radius=None,
+                socket="congruent", osteoporotic=b == 1, fovea=True))
+    if quick:
+        keep = {"g0-00", "g1-00", "g2-00", "g3-00", "g1-pelvis0", "g3-pelvis1"}
+        cts = [c for c in cts if c["id"] in keep]
+    return cts
+
+
+def run_ct(ct, bin_dir, work):
+    """Makes the phantom, runs each side and scores it; returns one row per head."""
+    d = os.path.join(work, ct["id"])
+    cmd = [f"{bin_dir}/articula", "phantom", "-o", f"{d}/ct", "--seed", str(ct["seed"]), "--exact", "--force", "-q",
+           "--spacing", ",".join(map(str, ct["spacing"])), "--gap", str(ct["gap"]), "--socket", ct["socket"],
+           "--side", ct["sides"][0]]
+    if ct["model"]:
+        cmd += ["--model", ct["model"]]
+    cmd += ["--radius", str(ct["radius"])] if ct["radius"] else ["--radius-range", "17,30"]
+    cmd += ["--both-hips"] * ct["both"] + ["--ras"] * ct["ras"] + ["--osteoporotic"] * ct["osteoporotic"]
+    cmd += ["--fovea"] * ct["fovea"] + ([] if ct["dicom"] else ["--no-dicom"])
+    t0 = time.time()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    phantom_s = time.time() - t0
+    truth = json.load(open(f"{d}/ct/truth.json"))
+    source = f"{d}/ct/dicom" if ct["dicom"] else f"{d}/ct/phantom.nii.gz"
+    rows = []
+    for side in ct["sides"]:
+        out = f"{d}/run-{side}"
+        t0 = time.time()
+        r = subprocess.run([f"{bin_dir}/articula", "run", "-i", source, "-o", out, "--joint", "hip", "--side", side,
+                            "--force", "-q", "--threads", "1"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                           text=True)
+        head = next(h for h in truth["hips"] if h["side"] == side)
+        row = dict(ct, side=side, exit=r.returncode, seconds=round(time.time() - t0, 1), phantom_s=round(phantom_s, 1),
+                   true_model=head["model"], true_radius=round(sum(head["radii_mm"]) / 3, 1),
+                   message=(r.stderr.strip().splitlines() or [""])[-1][:160])
+        if r.returncode == 0:
+            s = subprocess.run([f"{bin_dir}/bench-score-head", f"{d}/ct/truth.json", side, f"{out}/points.ply",
+                                f"{out}/results.json"], check=True, capture_output=True, text=True)
+            row.update(json.loads(s.stdout))
+            limit = 0.5 * min(ct["spacing"][0], ct["spacing"][1])
+            ok = row["rms_mm"] <= limit and row["share_within_1p5_mm"] >= 0.95
+            row["verdict"] = "correct" if ok else "SILENTLY WRONG"
+        else:
+            row["verdict"] = "refused"
+        rows.append(row)
+    return rows
+
+
+def fmt(v, spec=".2f"):
+    return "" if v is None else format(v, spec)
+
+
+def table(rows):
+    lines = ["| spacing group | heads | correct | refused | silently wrong | median centre error (mm) | "
+             "median RMS (mm) | median mean signed (mm) |", "|---|---|---|---|---|---|---|---|"]
+    for group, _ in GROUPS + [("all", None)]:
+        g = [r for r in rows if group in ("all", r["group"])]
+        if not g:
+            continue
+        share = lambda v: f"{100.0 * sum(r['verdict'] == v for r in g) / len(g):.0f} %"
+        scored = [r for r in g if r["exit"] == 0]
+        med = lambda k: fmt(statistics.median([r[k] for r in scored])) if scored else ""
+        lines.append(f"| {group} | {len(g)} | {share('correct')} | {share('refused')} | {share('SILENTLY WRONG')} | "
+                     f"{med('centre_error_mm')} | {med('rms_mm')} | {med('mean_signed_mm')} |")
+    lines += ["", "| case | side | spacing (mm) | input | model | radius (mm) | gap (mm) | socket | bone | fovea | "
+              "verdict | exit | centre error (mm) | RMS (mm) | mean signed (mm) | within 1.5 mm | run (s) | message |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        inp = ("DICOM" if r["dicom"] else "NIfTI") + (" RAS" if r["ras"] else " LPS")
+        lines.append(
+            f"| {r['id']} | {r['side']} | {'x'.join(map(str, r['spacing']))} | {inp} | {r['true_model']} | "
+            f"{r['true_radius']} | {r['gap']} | {r['socket']}{' (both hips)' if r['both'] else ''} | "
+            f"{'osteoporotic' if r['osteoporotic'] else 'normal'} | {'yes' if r['fovea'] else 'no'} | "
+            f"{r['verdict']} | {r['exit']} | {fmt(r.get('centre_error_mm'))} | {fmt(r.get('rms_mm'), '.3f')} | "
+            f"{fmt(r.get('mean_signed_mm'), '.3f')} | {fmt(100 * r['share_within_1p5_mm'], '.0f') + ' %' if 'share_within_1p5_mm' in r else ''} | "
+            f"{r['seconds']} | {r['message'] if r['exit'] else ''} |")
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--bin", default="build/bin")
+    ap.add_argument("--work", required=True)
+    ap.add_argument("-j", type=int, default=2)
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    bin_dir = os.path.abspath(args.bin)
+    os.makedirs(args.work, exist_ok=True)
+    cts = matrix(args.quick)
+    # Largest first, so that the slowest CTs do not finish last.
+    order = sorted(cts, key=lambda c: (-len(c["sides"]) * (1.0 / (c["spacing"][0] ** 2 * c["spacing"][2]))))
+    t0 = time.time()
+    rows = []
+    with futures.ThreadPoolExecutor(max_workers=args.j) as pool:
+        for done in futures.as_completed([pool.submit(run_ct, c, bin_dir, args.work) for c in order]):
+            for r in done.result():
+                rows.append(r)
+                print(f"{r['id']} {r['side']}: {r['verdict']} (exit {r['exit']}, {r['seconds']} s)", file=sys.stderr)
+    rows.sort(key=lambda r: (r["id"], r["side"]))
+    json.dump(rows, open(os.path.join(args.work, "robustness.json"), "w"), indent=1)
+    text = table(rows)
+    open(os.path.join(args.work, "robustness.md"), "w").write(text + "\n")
+    print(text)
+    print(f"\n{len(rows)} heads from {len(cts)} CTs in {time.time() - t0:.0f} s wall with -j {args.j}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

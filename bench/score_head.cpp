@@ -1,0 +1,90 @@
+// bench-score-head TRUTH.json SIDE POINTS.ply [RESULTS.json]: scores a run's
+// articular points against a phantom's true head of the given side (the
+// exact signed distance of lib/distance to the head less its fovea pit).
+// Prints one JSON line: n_points, rms_mm, mean_signed_mm (positive outside),
+// share_within_1p5_mm, max_abs_mm and, with RESULTS.json, centre_error_mm
+// (results' head_center_mm to the true centre). Used by bench/robustness.py.
+#include <cmath>
+#include <fstream>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "articula/distance/signed_distance.hpp"
+#include "articula/phantom/phantom.hpp"
+#include "articula/points/point_io.hpp"
+
+namespace {
+
+Eigen::Vector3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
+
+// The truth.json keys written by lib/phantom back into a Hip.
+articula::phantom::Hip hipFromTruth(const nlohmann::json& t) {
+  articula::phantom::Hip hip;
+  hip.right = t["side"] == "right";
+  articula::geometry::ShapeParameters& p = hip.head;
+  p.model = articula::geometry::modelFromName(t["model"].get<std::string>());
+  p.radii = vec3(t["radii_mm"]);
+  p.exponents = vec3(t["exponents"]);
+  for (int n = 0; n < 4; ++n) p.cx[n] = t["cx"][n].get<double>(), p.cy[n] = t["cy"][n].get<double>();
+  p.center = vec3(t["head_center_mm"]);
+  p.angles = vec3(t["angles_rad"]);
+  if (t.contains("fovea")) {
+    hip.fovea = true;
+    hip.fovea_center = vec3(t["fovea"]["center_mm"]);
+    hip.fovea_radius_mm = t["fovea"]["radius_mm"].get<double>();
+  }
+  return hip;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::cerr << "usage: bench-score-head TRUTH.json right|left POINTS.ply [RESULTS.json]\n";
+    return 2;
+  }
+  try {
+    const nlohmann::json truth = nlohmann::json::parse(std::ifstream(argv[1]));
+    const std::string side = argv[2];
+    const nlohmann::json* head = nullptr;
+    if (truth.contains("hips")) {
+      for (const auto& h : truth["hips"])
+        if (h["side"] == side) head = &h;
+    } else if (truth["side"] == side) {
+      head = &truth;  // a phantom from before hips[]
+    }
+    if (!head) {
+      std::cerr << argv[1] << ": no " << side << " hip in hips[]\n";
+      return 3;
+    }
+    const articula::phantom::Hip hip = hipFromTruth(*head);
+    const articula::distance::SignedDistance exact(hip.head);
+    const articula::points::PointCloud cloud = articula::points::readPoints(argv[3]);
+    const Eigen::Index n = cloud.positions.rows();
+    double sum = 0, sum2 = 0, max_abs = 0;
+    long within = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector3d x = cloud.positions.row(i).transpose();
+      const double d = articula::phantom::headSurfaceDistance(hip, exact.closest(x).distance, x);
+      sum += d;
+      sum2 += d * d;
+      max_abs = std::max(max_abs, std::fabs(d));
+      within += std::fabs(d) <= 1.5;
+    }
+    nlohmann::json out = {{"n_points", n},
+                          {"rms_mm", n ? std::sqrt(sum2 / n) : NAN},
+                          {"mean_signed_mm", n ? sum / n : NAN},
+                          {"share_within_1p5_mm", n ? double(within) / n : 0.0},
+                          {"max_abs_mm", max_abs}};
+    if (argc > 4) {
+      const nlohmann::json results = nlohmann::json::parse(std::ifstream(argv[4]));
+      out["centre_error_mm"] = (vec3(results["head_center_mm"]) - hip.head.center).norm();
+    }
+    std::cout << out.dump() << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "bench-score-head: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
