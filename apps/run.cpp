@@ -23,6 +23,8 @@
 #include "articula/geometry/shape.hpp"
 #include "articula/pipeline/csv.hpp"
 #include "articula/pipeline/markups.hpp"
+#include "articula/pipeline/qc.hpp"
+#include "articula/points/point_io.hpp"
 #include "articula/pipeline/statistics.hpp"
 
 namespace articula::apps {
@@ -51,6 +53,8 @@ const Forwarded kForwarded[] = {{"seed-point", "segment"},    {"series-uid", "se
 // (tests/apps/batch_killed.sh) the voxelised surface leaves the true model
 // 4-9 % above the most flexible one.
 constexpr double kDefaultSelectionTolerance = 0.10;
+// Default of --selection-floor (see pipeline::selectParsimonious).
+constexpr double kDefaultSelectionFloorMm = 0.03;
 
 // SHA-256 of a file, or of every file of a folder (a DICOM series) in name order.
 std::string hashInput(const fs::path& path) {
@@ -95,6 +99,10 @@ class RunCommand : public cli::Command {
     app.add_option("--from", from_, "First stage to run (earlier outputs must exist): " + stageList())
         ->check(CLI::IsMember(kStages));
     app.add_option("--until", until_, "Last stage to run")->check(CLI::IsMember(kStages));
+    app.add_option("--selection-floor", selection_floor_mm_,
+                   "Report: RMS differences up to this many mm never tell models apart (systematic error of the CT surface)")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
     app.add_option("--selection-tolerance", selection_tolerance_,
                    "Report: the selected model is the simplest whose RMS is within this fraction of the least RMS")
         ->check(CLI::Range(0.0, 10.0))
@@ -182,8 +190,8 @@ class RunCommand : public cli::Command {
            {errors / "summary.json", errors / "histogram.svg", errors / "error_map.svg"}};
     } else {
       // (The report runs in-process: its arguments only stamp it, so that a new tolerance reruns it.)
-      p = {{"--selection-tolerance", number(selection_tolerance_)},
-           {fits, errors / "summary.json"},
+      p = {{"--selection-tolerance", number(selection_tolerance_), "--selection-floor", number(selection_floor_mm_)},
+           {fits, errors / "summary.json", points},
            {output_ / "results.json", output_ / "results.csv", output_ / "head.mrk.json"}};
       return p;
     }
@@ -258,7 +266,7 @@ class RunCommand : public cli::Command {
     std::vector<pipeline::ModelScore> scores;
     for (const auto& m : models)
       scores.push_back({m.at("model"), m.at("n_parameters"), m.at("errors").value("rms_mm", NAN)});
-    const pipeline::ModelSelection selection = pipeline::selectParsimonious(scores, selection_tolerance_);
+    const pipeline::ModelSelection selection = pipeline::selectParsimonious(scores, selection_tolerance_, selection_floor_mm_);
     csv_header.push_back("selected");
     // results.csv: one row per model, units in the column names.
     std::vector<std::string> error_columns, parameter_columns;
@@ -289,32 +297,70 @@ class RunCommand : public cli::Command {
       axes.push_back({axis_names[i], c - best_shape.radii[i] * R.col(i), c + best_shape.radii[i] * R.col(i)});
     pipeline::writeSlicerMarkups(output_ / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
 
+    const pipeline::QcReport qc = checkHead(shapes);
+
     Provenance provenance;
     provenance.inputs = {input_.has_filename() && fs::is_regular_file(input_) ? input_ : fs::path(), fits_path, summary_path};
     provenance.inputs.erase(std::remove(provenance.inputs.begin(), provenance.inputs.end(), fs::path()), provenance.inputs.end());
     provenance.seed = common.seed;
     provenance.parameters = {
-        {"joint", joint_}, {"side", side_}, {"input", input_.string()}, {"selection_tolerance", selection_tolerance_}};
+        {"joint", joint_}, {"side", side_}, {"input", input_.string()}, {"selection_tolerance", selection_tolerance_},
+        {"selection_floor_mm", selection_floor_mm_}};
     const json results = {{"input", input_.string()},
                           {"joint", joint_},
                           {"side", side_},
                           {"best_model", best},
                           {"selected_model", selection.selected},
-                          {"selection", {{"rule", "the simplest model whose RMS is within the tolerance of the least RMS"},
+                          {"selection", {{"rule", "the simplest model whose RMS exceeds the least RMS by at most the larger of relative_tolerance x the least RMS and absolute_tolerance_mm"},
                                          {"relative_tolerance", selection_tolerance_},
+                                         {"absolute_tolerance_mm", selection_floor_mm_},
                                          {"indistinguishable", selection.indistinguishable}}},
                           {"head_center_mm", {c[0], c[1], c[2]}},
+                          {"qc", qc.toJson()},
                           {"models", models},
                           {"coordinate_system", "LPS"},
                           {"units", "mm"},
                           {"provenance", provenanceJson(provenance)}};
     writeFileAtomically(output_ / "results.csv", pipeline::csvLine(csv_header) + "\n" + csv_rows);
     writeFileAtomically(output_ / "results.json", results.dump(2) + "\n");
+    for (const std::string& reason : qc.reasons()) log::warn("qc " + reason);
+    if (qc.status == "fail")
+      throw ProcessingError("the result is not a plausible joint head (results.json, \"qc\"): " + qc.reasons().front());
+  }
+
+  // The checks of a head (pipeline/qc.hpp) on the articular points, their
+  // fitted sphere and the segmentation's own head, where it searched.
+  pipeline::QcReport checkHead(const std::vector<geometry::ShapeParameters>& shapes) const {
+    pipeline::HeadQcInput in;
+    const points::PointCloud cloud = points::readPoints(output_ / "points.ply");
+    in.points = cloud.positions;
+    in.normals = cloud.normals;
+    const auto sphere = std::find_if(shapes.begin(), shapes.end(),
+                                     [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
+    if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");
+    in.sphere_center = sphere->center;
+    in.sphere_radius_mm = sphere->radii[0];
+    const fs::path segment_summary = output_ / "label.nii.gz.json";
+    if (fs::exists(segment_summary)) {
+      try {
+        std::ifstream f(segment_summary);
+        const json seg = json::parse(f);
+        if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
+          const auto& sc = seg.at("head_center_mm");
+          in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());
+          in.search_radius_mm = seg.value("search_radius_mm", 0.0);
+        }
+      } catch (const json::exception& e) {
+        throw InputError("cannot read the segmentation summary '" + segment_summary.string() + "': " + e.what());
+      }
+    }
+    return pipeline::checkHead(in);
   }
 
   fs::path input_, output_;
   std::string joint_ = "hip", side_ = "right", from_, until_;
   double selection_tolerance_ = kDefaultSelectionTolerance;
+  double selection_floor_mm_ = kDefaultSelectionFloorMm;
   std::map<std::string, std::string> forwarded_;
 };
 

@@ -40,7 +40,8 @@ class SegmentCommand : public cli::Command {
     app.add_option("--close-radius", options_.close_radius_mm,
                    "Closing radius before hole filling, mm (bridges speckled cancellous bone; 0: off)")->capture_default_str();
     app.add_option("--midline-margin", options_.midline_margin_mm,
-                   "Least distance (mm) of an automatically found head from the volume's mid-sagittal plane")->capture_default_str();
+                   "Least distance (mm) of an automatically found head from the volume's mid-sagittal plane "
+                   "(-1: 40 mm when the field of view spans 250 mm or more left-right, else 0)")->capture_default_str();
     app.add_option("--min-coverage", options_.min_coverage,
                    "Least share (0-1) of an automatically found head's sphere that is bone surface")->capture_default_str();
     app.add_option("--roi", roi_, "Box xmin,ymin,zmin,xmax,ymax,zmax in LPS mm")->delimiter(',')->expected(6);

@@ -230,11 +230,23 @@ TEST(ModelSelection, TheSimplestModelWithinTheToleranceOfTheLeastRms) {
   s = pipeline::selectParsimonious({{"sphere", 4, 0.325}, {"ellipsoid", 9, 0.169}, {"superellipsoid", 12, 0.1105},
                                     {"ovoid", 15, 0.128}, {"superovoid", 18, 0.1100}});
   EXPECT_EQ(s.selected, "superellipsoid");
-  EXPECT_EQ(s.indistinguishable, (std::vector<std::string>{"superellipsoid", "superovoid"}));
-  // A 1 % tolerance keeps only the ovoids (0.1165 <= 1.01 x 0.1160): the
-  // simpler ovoid; with none, the least RMS. Equal counts go by RMS.
-  EXPECT_EQ(pipeline::selectParsimonious(sphere_truth, 0.01).selected, "ovoid");
-  EXPECT_EQ(pipeline::selectParsimonious(sphere_truth, 0.0).selected, "superovoid");
+  // (0.128 lies within the 0.03 mm floor of 0.1100: the ovoid is not told apart, but it is not simpler.)
+  EXPECT_EQ(s.indistinguishable, (std::vector<std::string>{"superellipsoid", "ovoid", "superovoid"}));
+  EXPECT_EQ(pipeline::selectParsimonious({{"sphere", 4, 0.325}, {"ellipsoid", 9, 0.169}, {"superellipsoid", 12, 0.1105},
+                                          {"ovoid", 15, 0.128}, {"superovoid", 18, 0.1100}}, 0.10, 0.0)
+                .indistinguishable,
+            (std::vector<std::string>{"superellipsoid", "superovoid"}));
+  // A 1 % tolerance without a floor keeps only the ovoids (0.1165 <= 1.01 x
+  // 0.1160): the simpler ovoid; with none, the least RMS. Equal counts go by RMS.
+  EXPECT_EQ(pipeline::selectParsimonious(sphere_truth, 0.01, 0.0).selected, "ovoid");
+  EXPECT_EQ(pipeline::selectParsimonious(sphere_truth, 0.0, 0.0).selected, "superovoid");
+  // A sphere on the CT's edge (articula run on the phantom of seed 21): the
+  // ovoids 13 % better, 0.018 mm, below the floor; the sphere is selected.
+  const std::vector<pipeline::ModelScore> sharp_sphere = {{"sphere", 4, 0.1397}, {"ellipsoid", 9, 0.1258},
+                                                          {"superellipsoid", 12, 0.1253}, {"ovoid", 15, 0.1220},
+                                                          {"superovoid", 18, 0.1216}};
+  EXPECT_EQ(pipeline::selectParsimonious(sharp_sphere).selected, "sphere");
+  EXPECT_EQ(pipeline::selectParsimonious(sharp_sphere, 0.10, 0.0).selected, "ellipsoid");
   EXPECT_EQ(pipeline::selectParsimonious({{"a", 4, 0.2}, {"b", 4, 0.19}}).selected, "b");
   // Nothing finite: nothing selected.
   EXPECT_EQ(pipeline::selectParsimonious({{"sphere", 4, NAN}}).selected, "");

@@ -117,9 +117,17 @@ Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
 }
 
 // A joint head's cap is nearly spherical: the RMS of its edges about their
-// sphere stays below this share of the radius; an ellipsoidal trochanter or
-// a tuberosity does not.
-constexpr double kMaxRelativeRms = 0.03;
+// sphere stays below this share of the radius (real femoral and humeral
+// heads 1-2.5 %, superellipsoids of exponents up to 2.6 about 3 %) plus a
+// quarter voxel of quantisation; an ellipsoidal trochanter or a tuberosity
+// does not.
+constexpr double kMaxRelativeRms = 0.04;
+constexpr double kRmsVoxelShare = 0.25;
+// A field of view this wide (left-right) holds both sides of the body: a
+// joint head then lies at least kAutomaticMidlineMargin from its middle
+// (hips 70-110 mm, shoulders 120-200 mm; vertebral bodies, near-spherical
+// too, lie on it).
+constexpr double kBothSidesWidthMm = 250, kAutomaticMidlineMargin = 40;
 constexpr int kRayCount = 512;
 
 /// A head measured from a point inside it: the sphere through the first bone
@@ -129,9 +137,11 @@ struct HeadCandidate {
   double radius = 0, coverage = 0, rms_mm = 0;  // coverage: share of the rays whose edge lies on the sphere
   std::vector<double> edge_mm;                  // per ray of the lattice, from `center`; NaN: no edge on the sphere
   double area() const { return coverage * 4 * M_PI * radius * radius; }
-  /// Edges on a third of the rays, within 3 % of the radius: a head's cap
-  /// seen through a visible gap. (Real femoral and humeral heads: 1-2.5 %.)
-  bool wellMeasured() const { return !edge_mm.empty() && coverage >= 0.3 && rms_mm <= kMaxRelativeRms * radius; }
+  /// Edges on a third of the rays and nearly spherical: a head's cap seen
+  /// through a visible gap.
+  bool wellMeasured(double voxel_mm) const {
+    return !edge_mm.empty() && coverage >= 0.3 && rms_mm <= kMaxRelativeRms * radius + kRmsVoxelShare * voxel_mm;
+  }
 };
 
 /// Casts kRayCount rays (Fibonacci lattice) from `start`, takes the first
@@ -330,6 +340,20 @@ void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head) {
   log::debug("cut beyond the head's edges: " + std::to_string(removed) + " voxels");
 }
 
+/// The margin about the field of view's middle (left-right) that no head
+/// lies in: as given, or automatic (options.midline_margin_mm < 0).
+double effectiveMidlineMargin(const ImageGeometry& g, const SegmentOptions& options) {
+  if (options.midline_margin_mm >= 0) return options.midline_margin_mm;
+  double lo = INFINITY, hi = -INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
+    const double x = g.toPhysical(ijk)[0];
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return hi - lo >= kBothSidesWidthMm ? kAutomaticMidlineMargin : 0.0;
+}
+
 /// Automatic head search: a 3-D Hough transform for spheres on a grid of
 /// about options.search_spacing_mm. Every voxel on the bone's surface votes
 /// along its inward HU gradient at the distances a head radius can have: the
@@ -394,6 +418,7 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
       if (cellOf(voter.x + t * voter.n, v)) votes[static_cast<size_t>(cg.linear(v[0], v[1], v[2]))] += 1.0f;
     }
   const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
+  const double midline_margin = effectiveMidlineMargin(g, options);
   struct Peak { Eigen::Vector3d x; double votes; };
   std::vector<Peak> peaks;
   for (int k = 1; k + 1 < cg.size[2]; ++k)
@@ -430,9 +455,9 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   // socket is never the first edge seen from the centre.
   const HeadCandidate* best = nullptr;
   for (const HeadCandidate& c : candidates) {
-    const bool plausible = c.wellMeasured() && c.radius >= r_lo && c.radius <= r_hi &&
+    const bool plausible = c.wellMeasured(g.spacing.maxCoeff()) && c.radius >= r_lo && c.radius <= r_hi &&
                            c.coverage >= options.min_coverage && (c.center[0] < mid_x) == (options.side == Side::Right) &&
-                           std::abs(c.center[0] - mid_x) >= options.midline_margin_mm && insideVolume(g, c.center);
+                           std::abs(c.center[0] - mid_x) >= midline_margin && insideVolume(g, c.center);
     if (plausible && (!best || c.area() > best->area())) best = &c;
   }
   if (best) {
@@ -449,7 +474,7 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
     log::debug("head candidate " + vec(p.x) + " mm by facing surface voxels: centre " + vec(c.center) + " mm, radius " +
                std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage));
     if (c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage &&
-        (c.center[0] < mid_x) == (options.side == Side::Right) && std::abs(c.center[0] - mid_x) >= options.midline_margin_mm &&
+        (c.center[0] < mid_x) == (options.side == Side::Right) && std::abs(c.center[0] - mid_x) >= midline_margin &&
         insideVolume(g, c.center)) {
       head = c;
       return true;
@@ -572,7 +597,8 @@ void SegmentOptions::validate() const {
   if (!(search_spacing_mm > 0)) throw UsageError("search spacing must be > 0");
   if (!(close_radius_mm >= 0)) throw UsageError("--close-radius must be >= 0");
   if (level_set_iterations < 0) throw UsageError("--level-set must be >= 0 iterations");
-  if (!(midline_margin_mm >= 0)) throw UsageError("--midline-margin must be >= 0");
+  if (!(midline_margin_mm >= 0 || midline_margin_mm == -1))
+    throw UsageError("--midline-margin must be >= 0 mm, or -1 for automatic");
   if (!(min_coverage >= 0 && min_coverage <= 1)) throw UsageError("--min-coverage must lie in [0, 1]");
 }
 
@@ -617,7 +643,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     depth = options.max_head_radius_mm;  // crop generously around a given seed
     head_found = measureHeadByRays(volume, center, options);
     measured = head_found.radius >= options.min_head_radius_mm && head_found.radius <= options.max_head_radius_mm &&
-               head_found.coverage >= options.min_coverage && head_found.rms_mm <= kMaxRelativeRms * head_found.radius &&
+               head_found.coverage >= options.min_coverage && head_found.wellMeasured(g.spacing.maxCoeff()) &&
                (head_found.center - center).norm() <= head_found.radius;
     if (measured) center = head_found.center, depth = head_found.radius;
   } else {
@@ -629,7 +655,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
       m << "no " << (options.joint == Joint::Hip ? "femoral" : "humeral") << " head found on the " << side
         << " side: no sphere of radius " << options.min_head_radius_mm << "-" << options.max_head_radius_mm
         << " mm has bone edges over " << options.min_coverage << " of its surface within "
-        << kMaxRelativeRms * 100 << " % RMS of its radius (-v lists the candidates);"
+        << kMaxRelativeRms * 100 << " % of its radius RMS (-v lists the candidates);"
         << " give --seed-point X,Y,Z (LPS mm) or adjust --hu-min";
       throw ProcessingError(m.str());
     }

@@ -86,7 +86,8 @@ WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vecto
 double aic(double sse, int n, int k) { return n * std::log(sse / n) + 2.0 * k; }
 double bic(double sse, int n, int k) { return n * std::log(sse / n) + k * std::log(static_cast<double>(n)); }
 
-ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance) {
+ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance,
+                                  double absolute_tolerance_mm) {
   ModelSelection out;
   double least = INFINITY;
   for (const auto& s : scores)
@@ -94,7 +95,7 @@ ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double 
   if (!std::isfinite(least)) return out;
   const ModelScore* chosen = nullptr;
   for (const auto& s : scores) {
-    if (!(s.rms_mm <= least * (1.0 + relative_tolerance))) continue;
+    if (!(s.rms_mm <= least + std::max(relative_tolerance * least, absolute_tolerance_mm))) continue;
     out.indistinguishable.push_back(s.model);
     if (!chosen || s.n_parameters < chosen->n_parameters ||
         (s.n_parameters == chosen->n_parameters && s.rms_mm < chosen->rms_mm))

@@ -33,7 +33,10 @@ struct SegmentOptions {
   double search_spacing_mm = 2.0;                   // grid of the automatic head search
   double close_radius_mm = 5.0;  // closing before hole filling: bridges speckled cancellous bone (0: off)
   double min_coverage = 0.15;       // least share of a found head's sphere that is bone surface
-  double midline_margin_mm = 0.0;   // a found head lies this far from the volume's mid-sagittal plane (30: never the spine, if the field of view holds both sides)
+  // A found head lies this far from the volume's mid-sagittal plane; -1:
+  // automatic, 40 mm when the field of view spans 250 mm or more left-right
+  // (both sides of the body: never the spine), else 0.
+  double midline_margin_mm = -1;
   double gap_width_mm = 4.0;     // widest joint gap the valley filter closes
   double gap_contrast_hu = 300;  // black top-hat above which a voxel is gap, not bone (0: off)
   double surface_hu = 400;       // level of the head's final surface (<= hu_min: the window's end)

@@ -1,0 +1,112 @@
+#include "articula/pipeline/qc.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "articula/core/error.hpp"
+
+namespace articula::pipeline {
+namespace {
+
+// Limits. A joint head's articular cap spans well over 45 degrees about its
+// centre (femoral heads about 80-110, humeral 60-90) and is nearly spherical
+// (RMS about its sphere 1-4 % of the radius); its normals point away from
+// its centre (a socket's inner surface points towards it).
+constexpr double kCapFailDeg = 30, kCapWarnDeg = 45;
+constexpr double kOutwardFail = 0.90, kOutwardWarn = 0.97;
+constexpr double kRmsWarn = 0.04, kRmsFail = 0.08;            // of the radius
+constexpr double kCentreWarn = 0.15, kCentreFail = 0.30;      // search vs fit, of the radius
+constexpr double kRadiusWarn = 0.15, kRadiusFail = 0.30;      // relative difference
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+/// Grades `value` (larger is worse unless `low_is_bad`) against a warn and a fail limit.
+QcCheck grade(const std::string& name, double value, double warn, double fail, bool low_is_bad, const std::string& what) {
+  QcCheck c;
+  c.name = name;
+  c.value = value;
+  const bool fails = low_is_bad ? value < fail : value > fail;
+  const bool warns = low_is_bad ? value < warn : value > warn;
+  c.status = fails ? "fail" : warns ? "warn" : "pass";
+  c.rule = std::string(low_is_bad ? "warn below " : "warn above ") + number(warn) + ", fail " +
+           (low_is_bad ? "below " : "above ") + number(fail);
+  if (fails || warns) c.reason = what + " " + number(value) + " (" + (fails ? "limit " + number(fail) : "doubtful beyond " + number(warn)) + ")";
+  return c;
+}
+
+}  // namespace
+
+std::vector<std::string> QcReport::reasons() const {
+  std::vector<std::string> out;
+  for (const QcCheck& c : checks)
+    if (c.status != "pass") out.push_back(c.status + ": " + c.reason);
+  return out;
+}
+
+nlohmann::json QcReport::toJson() const {
+  nlohmann::json checks_json = nlohmann::json::array();
+  for (const QcCheck& c : checks)
+    checks_json.push_back({{"name", c.name}, {"status", c.status}, {"value", c.value}, {"rule", c.rule}, {"reason", c.reason}});
+  return {{"status", status}, {"checks", checks_json}, {"reasons", reasons()}};
+}
+
+QcReport checkHead(const HeadQcInput& in) {
+  const Eigen::Index n = in.points.rows();
+  if (n < 4) throw InputError("head checks need at least 4 points, found " + std::to_string(n));
+  QcReport report;
+  const Eigen::Vector3d c = in.sphere_center;
+  const double r = in.sphere_radius_mm;
+
+  QcCheck radius;
+  radius.name = "head_radius_mm";
+  radius.value = r;
+  radius.rule = "fail outside [" + number(in.min_radius_mm) + ", " + number(in.max_radius_mm) + "] mm";
+  radius.status = r >= in.min_radius_mm && r <= in.max_radius_mm ? "pass" : "fail";
+  if (radius.status == "fail") radius.reason = "fitted sphere radius " + number(r) + " mm is not that of a joint head (" + radius.rule + ")";
+  report.checks.push_back(radius);
+
+  // The cap's half-angle: the 95th percentile of the points' angles from
+  // their mean direction about the centre.
+  Eigen::MatrixX3d u = in.points.rowwise() - c.transpose();
+  u.rowwise().normalize();
+  const Eigen::Vector3d axis = u.colwise().mean().transpose().normalized();
+  std::vector<double> angles(static_cast<size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i)
+    angles[static_cast<size_t>(i)] = std::acos(std::clamp(u.row(i).dot(axis.transpose()), -1.0, 1.0)) * 180 / M_PI;
+  std::nth_element(angles.begin(), angles.begin() + static_cast<long>(0.95 * (n - 1)), angles.end());
+  report.checks.push_back(grade("cap_half_angle_deg", angles[static_cast<size_t>(0.95 * (n - 1))], kCapWarnDeg, kCapFailDeg,
+                                true, "the articular cap spans a half-angle of only (degrees)"));
+
+  if (in.normals.rows() == n) {
+    Eigen::Index outward = 0;
+    for (Eigen::Index i = 0; i < n; ++i) outward += in.normals.row(i).dot(in.points.row(i) - c.transpose()) > 0;
+    report.checks.push_back(grade("normals_outward_share", static_cast<double>(outward) / n, kOutwardWarn, kOutwardFail,
+                                  true, "share of point normals pointing away from the head's centre (a socket's point towards it):"));
+  }
+
+  const Eigen::ArrayXd residual = (in.points.rowwise() - c.transpose()).rowwise().norm().array() - r;
+  const double rms = std::sqrt(residual.square().mean());
+  report.checks.push_back(grade("sphere_rms_relative", rms / r, kRmsWarn, kRmsFail, false,
+                                "RMS of the points about their sphere, relative to its radius:"));
+
+  if (in.search_center) {
+    report.checks.push_back(grade("search_centre_offset_relative", (*in.search_center - c).norm() / r, kCentreWarn,
+                                  kCentreFail, false, "the head search's centre lies away from the fitted one, relative to the radius:"));
+    if (in.search_radius_mm > 0)
+      report.checks.push_back(grade("search_radius_difference_relative", std::abs(in.search_radius_mm - r) / r, kRadiusWarn,
+                                    kRadiusFail, false, "the head search's radius differs from the fitted one, relative:"));
+  }
+  for (const QcCheck& check : report.checks) {
+    if (check.status == "fail") report.status = "fail";
+    else if (check.status == "warn" && report.status == "pass") report.status = "warn";
+  }
+  return report;
+}
+
+}  // namespace articula::pipeline

@@ -1,0 +1,92 @@
+// Head checks: a head's cap passes; each wrong structure fails the check
+// made to reveal it (a socket's inner surface, a small trochanter-like
+// blob, a cut cap, a non-spherical patch, a search that found elsewhere).
+#include <gtest/gtest.h>
+
+#include "articula/geometry/fibonacci.hpp"
+#include "articula/pipeline/qc.hpp"
+
+namespace articula {
+namespace {
+
+/// Points of a sphere cap of half-angle `cap_deg` about +z, with normals
+/// pointing outwards (or inwards, as a socket's inner surface has them).
+pipeline::HeadQcInput cap(double radius, double cap_deg, bool inward_normals = false) {
+  pipeline::HeadQcInput in;
+  const int n = 800;
+  const Eigen::Vector3d centre(-90, -10, 30);
+  in.points.resize(n, 3);
+  in.normals.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d u = geometry::fibonacciDirection(i, n, std::cos(cap_deg * M_PI / 180));
+    in.points.row(i) = (centre + radius * u).transpose();
+    in.normals.row(i) = (inward_normals ? -u : u).transpose();
+  }
+  in.sphere_center = centre;
+  in.sphere_radius_mm = radius;
+  return in;
+}
+
+const pipeline::QcCheck& check(const pipeline::QcReport& r, const std::string& name) {
+  for (const auto& c : r.checks)
+    if (c.name == name) return c;
+  throw std::runtime_error("no check " + name);
+}
+
+TEST(HeadQc, AFemoralHeadsCapPasses) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.search_center = in.sphere_center + Eigen::Vector3d(0.5, 0, 0);
+  in.search_radius_mm = 23.4;
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(r.status, "pass") << r.toJson().dump();
+  EXPECT_TRUE(r.reasons().empty());
+  EXPECT_EQ(r.checks.size(), 6u);
+}
+
+TEST(HeadQc, ASocketsInnerSurfaceFailsOnItsNormals) {
+  const pipeline::QcReport r = pipeline::checkHead(cap(26, 80, true));
+  EXPECT_EQ(r.status, "fail");
+  EXPECT_EQ(check(r, "normals_outward_share").status, "fail");
+  EXPECT_EQ(check(r, "head_radius_mm").status, "pass");  // its radius alone would not tell
+}
+
+TEST(HeadQc, ATrochanterSizedSphereFailsOnItsRadius) {
+  const pipeline::QcReport r = pipeline::checkHead(cap(11, 80));
+  EXPECT_EQ(check(r, "head_radius_mm").status, "fail");
+  EXPECT_EQ(r.status, "fail");
+  EXPECT_NE(r.reasons().front().find("not that of a joint head"), std::string::npos);
+}
+
+TEST(HeadQc, ACutCapFailsOrWarnsOnItsExtent) {
+  EXPECT_EQ(check(pipeline::checkHead(cap(23, 20)), "cap_half_angle_deg").status, "fail");
+  EXPECT_EQ(check(pipeline::checkHead(cap(23, 40)), "cap_half_angle_deg").status, "warn");
+  EXPECT_EQ(check(pipeline::checkHead(cap(23, 60)), "cap_half_angle_deg").status, "pass");
+}
+
+TEST(HeadQc, ANonSphericalPatchFailsOnItsSpread) {
+  pipeline::HeadQcInput in = cap(23, 80);
+  // An elongated blob (axes 13, 15 and 20 mm scaled to a 23 mm mean): its sphere leaves >8 % RMS.
+  for (Eigen::Index i = 0; i < in.points.rows(); ++i) {
+    const Eigen::Vector3d d = in.points.row(i).transpose() - in.sphere_center;
+    in.points.row(i) = (in.sphere_center + d.cwiseProduct(Eigen::Vector3d(0.75, 0.9, 1.3))).transpose();
+  }
+  EXPECT_EQ(check(pipeline::checkHead(in), "sphere_rms_relative").status, "fail");
+}
+
+TEST(HeadQc, ASearchThatFoundAnotherStructureFails) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.search_center = in.sphere_center + Eigen::Vector3d(0, 12, 0);  // half a radius away
+  in.search_radius_mm = 16;
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "search_centre_offset_relative").status, "fail");
+  EXPECT_EQ(check(r, "search_radius_difference_relative").status, "fail");
+}
+
+TEST(HeadQc, TooFewPointsAreRefused) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.points.conservativeResize(3, 3);
+  EXPECT_THROW(pipeline::checkHead(in), std::exception);
+}
+
+}  // namespace
+}  // namespace articula
