@@ -61,15 +61,18 @@ class MeshCommand : public cli::Command {
       mesh::snapToEdges(m, ct, snap_, &snapped);
       const double share = snapped.vertices ? static_cast<double>(snapped.on_edge) / snapped.vertices : 0.0;
       edges = {{"ct", ct_.string()},
+               {"moved", snapped.moved},
                {"vertices_on_edge", snapped.on_edge},
                {"share_on_edge", share},
                {"mean_shift_mm", snapped.mean_shift_mm},
                {"mean_abs_shift_mm", snapped.mean_abs_shift_mm}};
-      log::info("mesh: " + std::to_string(snapped.on_edge) + " of " + std::to_string(snapped.vertices) +
-                " vertices moved onto the CT's edge (mean shift " + std::to_string(snapped.mean_shift_mm) + " mm)");
-      if (share < 0.5)
+      if (snapped.moved)
+        log::info("mesh: " + std::to_string(snapped.on_edge) + " of " + std::to_string(snapped.vertices) +
+                  " vertices on the CT's edge (mean shift " + std::to_string(snapped.mean_shift_mm) + " mm)");
+      if (!snapped.moved)
         log::warn("mesh: only " + std::to_string(static_cast<int>(100 * share)) +
-                  " % of the vertices found a bone edge in the CT: is it the CT the label was made from?");
+                  " % of the vertices found a bone edge in the CT (coarse or lossy voxels, or not the CT the label "
+                  "was made from): the surface stays the label's");
     }
     mesh::writeMesh(output_, m, true);
     log::info("mesh: " + std::to_string(s.vertices) + " vertices, " + std::to_string(s.triangles) + " triangles");

@@ -763,9 +763,27 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   // third of a voxel outside in partial volume).
   if (options.level_set_iterations > 0) {
     head = refineByLevelSet(box_hu, head, options.level_set_iterations);
+  } else if (!measured && options.surface_hu > options.hu_min) {
+    // No cut along the head's edges (coarse voxels): peel the label's outer
+    // layer twice where it is darker than surface_hu, which opens the thin
+    // partial-volume bridges to the socket (the cortex keeps the darker
+    // cancellous interior inside). With the cut, the label ends where the HU
+    // window does and the mesh stage places the surface on the CT's edge.
+    for (int peel = 0; peel < 2; ++peel) {
+      Mask next = head;
+      for (int k = 0; k < bg.size[2]; ++k)
+        for (int j = 0; j < bg.size[1]; ++j)
+          for (int i = 0; i < bg.size[0]; ++i) {
+            if (!head.at(i, j, k) || box_hu.at(i, j, k) >= options.surface_hu) continue;
+            const bool outer = i == 0 || j == 0 || k == 0 || i + 1 == bg.size[0] || j + 1 == bg.size[1] ||
+                               k + 1 == bg.size[2] || !head.at(i - 1, j, k) || !head.at(i + 1, j, k) ||
+                               !head.at(i, j - 1, k) || !head.at(i, j + 1, k) || !head.at(i, j, k - 1) ||
+                               !head.at(i, j, k + 1);
+            if (outer) next.at(i, j, k) = 0;
+          }
+      head = next;
+    }
   }
-  // (Without the contour, the label ends where the HU window does; the mesh
-  // stage places the surface on the CT's edge, imaging/edges.hpp.)
 
   Label label;
   label.geometry = g;

@@ -215,6 +215,7 @@ void EdgeSnapOptions::validate() const {
 
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary) {
+  constexpr double kMinShareOnEdge = 0.5;
   options.validate();
   const Eigen::Index n = mesh.vertices.rows();
   if (mesh.normals.rows() != n) throw ProcessingError("snapping to the CT's edges needs vertex normals");
@@ -237,6 +238,12 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     shift[static_cast<size_t>(v)] = e.offset_mm;
     found[static_cast<size_t>(v)] = 1;
     ++s.on_edge;
+  }
+  // Too few edges (coarse or lossy CT, or another CT than the label's): the
+  // shifts would be guesses from far neighbours; the surface stays the label's.
+  if (static_cast<double>(s.on_edge) < kMinShareOnEdge * static_cast<double>(n)) {
+    if (summary) *summary = s;
+    return;
   }
   // Neighbour averages over the triangles' edges: the found shifts smoothed,
   // the others taken from found neighbours (repeatedly, as far as the passes reach).
@@ -269,6 +276,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     s.mean_abs_shift_mm += std::abs(d) / static_cast<double>(n);
   }
   mesh.normals = fromVtk(withNormals(toVtk(mesh))).normals;
+  s.moved = true;
   if (summary) *summary = s;
 }
 

@@ -54,6 +54,7 @@ struct EdgeSnapOptions {
 
 struct EdgeSnapSummary {
   long long vertices = 0, on_edge = 0;  // vertices, those with an edge found along their normal
+  bool moved = false;                   // false: too few edges, the surface is the label's
   double mean_shift_mm = 0;             // mean signed shift along the outward normal
   double mean_abs_shift_mm = 0;
 };
@@ -63,7 +64,8 @@ struct EdgeSnapSummary {
 /// the cortex meets soft tissue at sub-voxel precision and not where the
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours.
-/// Normals are recomputed. The CT's grid may differ from the label's.
+/// Normals are recomputed. The CT's grid may differ from the label's. When
+/// fewer than half the vertices find an edge, nothing moves (summary tells).
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary = nullptr);
 
