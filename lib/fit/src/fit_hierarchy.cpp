@@ -601,6 +601,32 @@ std::vector<Start> axisLabellings(const Fitted& parent) {
   return out;
 }
 
+// Superellipsoid starts beyond the ellipsoid's: a femoral head's radii lie
+// within a few per cent of each other, so the ellipsoid's axes are nearly
+// arbitrary there, and a local search cannot turn the exponents a quarter
+// turn onto the head's own axes. So: the ellipsoid; each of its axes with a
+// larger exponent; and its frame turned by 45 degrees either way about each
+// axis, boxy (exponents 2.4). Screened on a subsample, the best finished.
+std::vector<Start> superellipsoidStarts(const Fitted& ellipsoid) {
+  const ShapeParameters e = geometry::promote(ellipsoid.fit.parameters, ShapeModel::Superellipsoid);
+  std::vector<Start> out{{"ellipsoid", e, ellipsoid.feet}};
+  for (int i = 0; i < 3; ++i) {
+    ShapeParameters p = e;
+    p.exponents[i] = 2.4;
+    out.push_back({std::string("ellipsoid, exponent 2.4 on ") + "xyz"[i], p, {}});
+  }
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(e.angles);
+  for (int i = 0; i < 3; ++i)
+    for (double turn : {M_PI / 4, -M_PI / 4}) {
+      ShapeParameters p = e;
+      p.angles = geometry::anglesFromRotation(R * Eigen::AngleAxisd(turn, Eigen::Vector3d::Unit(i)).toRotationMatrix());
+      p.exponents.setConstant(2.4);
+      p.radii.setConstant(e.radii.mean());
+      out.push_back({std::string("ellipsoid turned ") + (turn > 0 ? "+" : "-") + "45 deg about " + "xyz"[i], p, {}});
+    }
+  return out;
+}
+
 // A third superovoid start that joins what both parents learnt: the ovoid
 // with the exponents of the superellipsoid, each taken from the
 // superellipsoid axis most parallel to the ovoid's.
@@ -690,8 +716,8 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   const bool need_o = wanted(ShapeModel::Ovoid) || wanted(ShapeModel::Superovoid);
   Fitted superellipsoid, ovoid, superovoid;
   if (need_se) {
-    superellipsoid = fitModel(ShapeModel::Superellipsoid, {{"ellipsoid", ellipsoid.fit.parameters, ellipsoid.feet}},
-                              bounds(ShapeModel::Superellipsoid), points, o);
+    superellipsoid = fitModel(ShapeModel::Superellipsoid, superellipsoidStarts(ellipsoid),
+                              bounds(ShapeModel::Superellipsoid), points, o, o.screening_evaluations);
     enforceNesting(superellipsoid, ellipsoid, points);
   }
   if (need_o) {
