@@ -43,6 +43,7 @@ python3 - "$tmp/killed" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(f"{sys.argv[1]}/study.csv")))
 selected = {r["subject"]: r["model"] for r in rows if r["selected"] == "1"}
+assert {r["qc_status"] for r in rows} == {"pass"}, [(r["subject"], r["qc_status"], r["qc_reasons"]) for r in rows]
 assert selected == {"s1": "sphere", "s2": "ellipsoid", "s3": "superellipsoid"}, selected
 summary = {r["model"]: r for r in csv.DictReader(open(f"{sys.argv[1]}/study_summary.csv"))}
 assert [summary[m]["times_selected"] for m in ("sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid")] == \

@@ -37,6 +37,7 @@ struct ModelRow {
   nlohmann::json entry;  // the model's entry of results.json
   bool best = false;
   bool selected = false;  // results.json's selected_model
+  std::string qc_status, qc_reasons;  // results.json's qc (the subject's)
 };
 
 // study.svg: RMS per model, subject by subject (subjects in manifest order).
@@ -77,8 +78,15 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
       throw ProcessingError("cannot read '" + path.string() + "': " + e.what());
     }
     const std::string best = results.value("best_model", ""), selected = results.value("selected_model", "");
+    std::string qc_status, qc_reasons;
+    if (results.contains("qc") && results.at("qc").is_object()) {
+      qc_status = results.at("qc").value("status", "");
+      for (const auto& reason : results.at("qc").value("reasons", nlohmann::json::array()))
+        if (reason.is_string()) qc_reasons += (qc_reasons.empty() ? "" : "; ") + reason.get<std::string>();
+    }
     for (const auto& m : results.at("models")) {
-      ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best, m.at("model") == selected};
+      ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best, m.at("model") == selected,
+                   qc_status, qc_reasons};
       for (const auto& [key, value] : m.at("parameters").items())
         if (std::find(parameter_columns.begin(), parameter_columns.end(), key) == parameter_columns.end())
           parameter_columns.push_back(key);
@@ -91,7 +99,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   // study.csv
   std::vector<std::string> header = {"subject", "model", "n_parameters"};
   header.insert(header.end(), kErrorColumns.begin(), kErrorColumns.end());
-  header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected"});
+  header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected", "qc_status", "qc_reasons"});
   header.insert(header.end(), parameter_columns.begin(), parameter_columns.end());
   std::string study_csv = csvLine(header) + "\n";
   for (const auto& r : rows) {
@@ -101,6 +109,8 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     f.push_back(number(r.entry.value("bic", NAN)));
     f.push_back(r.best ? "1" : "0");
     f.push_back(r.selected ? "1" : "0");
+    f.push_back(r.qc_status);
+    f.push_back(r.qc_reasons);
     for (const auto& c : parameter_columns)
       f.push_back(r.entry.at("parameters").contains(c) ? number(r.entry.at("parameters").at(c).get<double>()) : "");
     study_csv += csvLine(f) + "\n";
