@@ -13,6 +13,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/distance/signed_distance.hpp"
@@ -105,14 +106,20 @@ class ErrorsCommand : public cli::Command {
     const std::vector<geometry::ShapeParameters> shapes = fit::shapesFromFitsJson(doc, fits_.string());
     if (std::filesystem::exists(output_) && !std::filesystem::is_directory(output_))
       throw UsageError("--output: expected a folder, found the file '" + output_.string() + "'");
+    // Every file this stage writes, checked before any is: none an input, none left over without --force.
+    std::vector<std::filesystem::path> outputs;
+    for (const char* f : {"summary.csv", "summary.json", "errors.csv", "histogram.svg", "error_map.svg"})
+      outputs.push_back(output_ / f);
+    for (const auto& shape : shapes)
+      for (const char* kind : {"points_", "surface_"})
+        outputs.push_back(output_ / (kind + geometry::modelName(shape.model) + ".ply"));
+    refuseOutputsOverInputs(outputs, {input_, fits_});
+    for (const auto& f : outputs)
+      if (std::filesystem::exists(f) && !common.force)
+        throw UsageError("output '" + f.string() + "' exists (use --force to overwrite)");
     std::error_code ec;
     std::filesystem::create_directories(output_, ec);
     if (ec) throw InputError("--output: cannot create the folder '" + output_.string() + "': " + ec.message());
-    const std::vector<std::string> outputs = {"summary.csv", "summary.json", "errors.csv", "histogram.svg",
-                                             "error_map.svg"};
-    for (const auto& f : outputs)
-      if (std::filesystem::exists(output_ / f) && !common.force)
-        throw UsageError("output '" + (output_ / f).string() + "' exists (use --force to overwrite)");
 
     const Eigen::MatrixX3d& P = cloud.positions;
     std::vector<report::ErrorStatistics> rows;

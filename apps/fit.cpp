@@ -9,6 +9,8 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
+#include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
@@ -34,7 +36,7 @@ std::map<std::string, std::pair<double, double>> readBounds(const std::filesyste
   std::map<std::string, std::pair<double, double>> bounds;
   for (const auto& [name, v] : j.items()) {
     if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
-      throw InputError("--bounds: '" + path.string() + "': \"" + name + "\" expected [lower, upper], found " + v.dump());
+      throw InputError("--bounds: '" + path.string() + "': \"" + name + "\" expected [lower, upper], found " + describeJson(v));
     bounds[name] = {v[0].get<double>(), v[1].get<double>()};
   }
   return bounds;
@@ -94,6 +96,7 @@ class FitCommand : public cli::Command {
     o.validate();
     if (output_.extension() != ".json") throw UsageError("--output: expected a .json file, found '" + output_.string() + "'");
     const std::filesystem::path csv = std::filesystem::path(output_).replace_extension(".csv");
+    refuseOutputsOverInputs({output_, csv}, {input_, bounds_file_});
     for (const auto& path : {output_, csv})
       if (std::filesystem::exists(path) && !common.force)
         throw UsageError("output '" + path.string() + "' exists (use --force to overwrite)");

@@ -3,6 +3,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/imaging/io.hpp"
@@ -49,6 +50,7 @@ class MeshCommand : public cli::Command {
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
     snap_.validate();
+    refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
     const imaging::Label label = imaging::readLabel(input_);
     mesh::MeshSummary s;
     mesh::TriangleMesh m = mesh::extractSurface(label, options_, &s);

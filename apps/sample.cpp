@@ -6,6 +6,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/mesh/mesh.hpp"
@@ -47,6 +48,7 @@ class SampleCommand : public cli::Command {
     if (!format_.empty()) output_.replace_extension(format_);
     const std::string ext = output_.extension().string();
     if (ext != ".ply" && ext != ".csv") throw UsageError("--output: expected a .ply or .csv file, found '" + output_.string() + "'");
+    refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
 

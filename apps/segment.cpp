@@ -5,6 +5,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/imaging/io.hpp"
@@ -57,6 +58,7 @@ class SegmentCommand : public cli::Command {
       options_.roi_max = Eigen::Vector3d(roi_[3], roi_[4], roi_[5]);
     }
     options_.validate();
+    refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 #include "articula/geometry/pose.hpp"
 
 namespace articula::fit {
@@ -21,11 +22,11 @@ Eigen::Matrix<double, N, 1> vectorAt(const nlohmann::json& entry, const char* ke
   const nlohmann::json& v = entry.at(key);
   if (!v.is_array() || v.size() != N)
     throw InputError(where + ": \"" + key + "\" expected an array of " + std::to_string(N) + " numbers, found " +
-                     v.dump());
+                     describeJson(v));
   Eigen::Matrix<double, N, 1> out;
   for (int i = 0; i < N; ++i) {
     if (!v[static_cast<size_t>(i)].is_number())
-      throw InputError(where + ": \"" + key + "\" expected numbers, found " + v.dump());
+      throw InputError(where + ": \"" + key + "\" expected numbers, found " + describeJson(v[static_cast<size_t>(i)]));
     out[i] = v[static_cast<size_t>(i)].get<double>();
   }
   return out;
@@ -61,7 +62,7 @@ nlohmann::json modelFitJson(const ModelFit& f) {
 }
 
 geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where) {
-  if (!entry.is_object()) throw InputError(where + ": expected an object, found " + entry.dump());
+  if (!entry.is_object()) throw InputError(where + ": expected an object, found " + describeJson(entry));
   if (!entry.contains("model") || !entry.at("model").is_string())
     throw InputError(where + ": missing string key \"model\"");
   geometry::ShapeParameters p;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 
 namespace articula::geometry {
 
@@ -27,7 +28,7 @@ const std::vector<ShapeModel>& allModels() {
 ShapeModel modelFromName(const std::string& name) {
   for (ShapeModel m : allModels())
     if (modelName(m) == name) return m;
-  throw UsageError("unknown shape model '" + name +
+  throw UsageError("unknown shape model '" + excerpt(name) +
                    "': expected one of sphere, ellipsoid, superellipsoid, ovoid, superovoid");
 }
 
