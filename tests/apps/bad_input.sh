@@ -43,4 +43,17 @@ mkdir -p "$tmp/mixed" && echo old > "$tmp/mixed/points_superovoid.ply"
 expect_rc 2 "$A" errors -i "$tmp/head.csv" --fits "$tmp/fits.json" -o "$tmp/mixed"
 grep -q "points_superovoid.ply' exists" "$tmp/err" || fail "mixed outputs: $(cat "$tmp/err")"
 [ "$(ls "$tmp/mixed")" = "points_superovoid.ply" ] || fail "errors wrote beside an old output: $(ls "$tmp/mixed")"
+# Contact pairs far beyond the solver's range (a centre at 1e300, radii of
+# 1e300, crossing needles of axes 1e-9 and 1e9): each row refused by line
+# (a bad row is skipped and named; only bad rows: exit 3 and no output).
+pairs="$tmp/far.csv"
+{ head -1 "$ARTICULA_SOURCE/testdata/contact/pairs.csv"
+  echo "1e300,0,0,1,0,0,0,2,2,2,2,2,2,,4,0,0,1,0,0,0,1,1,1,2,2,2,,,"
+  echo "0,0,0,1,0,0,0,1e300,2,2,2,2,2,,4,0,0,1,0,0,0,1,1,1,2,2,2,,,"
+  echo "0,0,0,1,0,0,0,1e9,1e-9,1e-9,2,2,2,,0,0,0,0.7071067811865476,0,0,0.7071067811865476,1e9,1e-9,1e-9,2,2,2,,,"
+} > "$pairs"
+expect_rc 3 "$A" contact --pairs "$pairs" -o "$tmp/far_out.csv"
+for line in 2 3 4; do grep -q "far.csv:$line:" "$tmp/err" || fail "contact row $line not named: $(cat "$tmp/err")"; done
+grep -q "1e-06 to 1e+06 mm\|1e-6 to 1e6 mm" "$tmp/err" || fail "contact: the range is not stated: $(cat "$tmp/err")"
+[ ! -e "$tmp/far_out.csv" ] || fail "contact wrote an output of refused rows"
 echo "bad input: ok"

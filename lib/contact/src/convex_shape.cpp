@@ -16,12 +16,17 @@ ConvexShape makeConvexShape(const Vector3d& center, const Eigen::Matrix3d& rotat
                             const Vector3d& exponents) {
   static const char* radius_names[3] = {"a", "b", "c"};
   static const char* exponent_names[3] = {"gamma1", "gamma2", "gamma3"};
+  // The range in which the solver's double arithmetic holds (a length of
+  // 1e6 squared and summed stays far from overflow; 1e-6 mm is below any
+  // body's size): beyond it, results would be noise, so the shape is refused.
+  constexpr double kMinRadius = 1e-6, kMaxLength = 1e6;
   for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(radii[i]) || !(radii[i] > 0.0))
-      throw InvalidParameter(radius_names[i], "a finite radius > 0 mm", radii[i]);
+    if (!std::isfinite(radii[i]) || !(radii[i] >= kMinRadius && radii[i] <= kMaxLength))
+      throw InvalidParameter(radius_names[i], "a radius from 1e-6 to 1e6 mm", radii[i]);
     if (!std::isfinite(exponents[i]) || !(exponents[i] >= 2.0))
       throw InvalidParameter(exponent_names[i], "a finite exponent >= 2 (smooth and convex)", exponents[i]);
-    if (!std::isfinite(center[i])) throw InvalidParameter("center", "a finite coordinate (mm)", center[i]);
+    if (!std::isfinite(center[i]) || !(std::abs(center[i]) <= kMaxLength))
+      throw InvalidParameter("center", "a coordinate within +-1e6 mm", center[i]);
   }
   const double orthogonality = (rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!std::isfinite(orthogonality) || orthogonality > 1e-9)
