@@ -114,12 +114,20 @@ class ErrorsCommand : public cli::Command {
       for (const char* kind : {"points_", "surface_"})
         outputs.push_back(output_ / (kind + geometry::modelName(shape.model) + ".ply"));
     refuseOutputsOverInputs(outputs, {input_, fits_});
+    // An interrupted run of this stage left its marker (removed once
+    // summary.json, written last, is in place): its files are redone
+    // without --force. Any other existing output needs --force.
+    const std::filesystem::path marker = output_ / ".errors-incomplete";
+    const bool interrupted = std::filesystem::exists(marker);
     for (const auto& f : outputs)
-      if (std::filesystem::exists(f) && !common.force)
+      if (!interrupted && std::filesystem::exists(f) && !common.force)
         throw UsageError("output '" + f.string() + "' exists (use --force to overwrite)");
+    if (std::filesystem::is_directory(output_)) removeStaleTemporaries(output_);
+    const bool overwrite = common.force || interrupted;
     std::error_code ec;
     std::filesystem::create_directories(output_, ec);
     if (ec) throw InputError("--output: cannot create the folder '" + output_.string() + "': " + ec.message());
+    writeFileAtomically(marker, "articula errors: writing; this folder is incomplete until summary.json is written\n", true);
 
     const Eigen::MatrixX3d& P = cloud.positions;
     std::vector<report::ErrorStatistics> rows;
@@ -135,26 +143,18 @@ class ErrorsCommand : public cli::Command {
       const std::string comment = "articula errors: " + name + " signed Euclidean distances (mm), points " +
                                   input_.filename().string();
       writeFileAtomically(output_ / ("points_" + name + ".ply"),
-                          report::colouredPointsPly(P, d, band_mm_, comment), common.force);
+                          report::colouredPointsPly(P, d, band_mm_, comment), overwrite);
       const auto surface = geometry::makeSurface(shapes[m]);
       const geometry::SurfaceMesh patch = surfacePatch(*surface, P, resolution_);
       writeFileAtomically(output_ / ("surface_" + name + ".ply"),
-                          report::meshPly(patch.vertices, patch.triangles, "articula fitted " + name), common.force);
+                          report::meshPly(patch.vertices, patch.triangles, "articula fitted " + name), overwrite);
     }
 
     nlohmann::json params = {{"fits", fits_.string()}, {"band_mm", band_mm_}, {"resolution", resolution_}};
     const nlohmann::json provenance = provenanceJson({params, {input_, fits_}, -1});
-    writeFileAtomically(output_ / "summary.csv", report::summaryCsv(rows), common.force);
-    writeFileAtomically(output_ / "summary.json",
-                        nlohmann::json({{"coordinate_system", "LPS"},
-                                        {"units", "mm"},
-                                        {"models", report::summaryJson(rows)},
-                                        {"provenance", provenance}})
-                                .dump(2) +
-                            "\n",
-                        common.force);
+    writeFileAtomically(output_ / "summary.csv", report::summaryCsv(rows), overwrite);
     {
-      AtomicFile file(output_ / "errors.csv", common.force);
+      AtomicFile file(output_ / "errors.csv", overwrite);
       std::ostream& out = file.stream();
       out << "x_mm,y_mm,z_mm";
       for (const auto& s : shapes) out << ",d_" << geometry::modelName(s.model) << "_mm";
@@ -168,7 +168,7 @@ class ErrorsCommand : public cli::Command {
     }
     writeFileAtomically(output_ / "histogram.svg",
                         report::histogramSvg(series, "Signed Euclidean distances: " + input_.filename().string()),
-                        common.force);
+                        overwrite);
     // Maps about the best model's centre (fits.json's best_model, else the least RMS here).
     size_t best = 0;
     for (size_t m = 0; m < shapes.size(); ++m)
@@ -183,7 +183,17 @@ class ErrorsCommand : public cli::Command {
     writeFileAtomically(output_ / "error_map.svg",
                         report::errorMapSvg(report::azimuthalEqualArea(P, shapes[best].center), panels, map_options,
                                             "Signed distances to the fitted surfaces: " + input_.filename().string()),
-                        common.force);
+                        overwrite);
+    // Last: summary.json, then the marker goes: the folder is complete.
+    writeFileAtomically(output_ / "summary.json",
+                        nlohmann::json({{"coordinate_system", "LPS"},
+                                        {"units", "mm"},
+                                        {"models", report::summaryJson(rows)},
+                                        {"provenance", provenance}})
+                                .dump(2) +
+                            "\n",
+                        true);
+    std::filesystem::remove(marker);
     if (common.json) cli::printJson({{"output", output_.string()}, {"models", report::summaryJson(rows)}});
     return 0;
   }

@@ -7,7 +7,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake git pkg-config libssl-dev
   libinsighttoolkit5-dev libvtk9-dev libcgal-dev libeigen3-dev
-  libnlopt-cxx-dev libcli11-dev nlohmann-json3-dev
+  libnlopt-cxx-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
   # measured peers (contact benchmarks) and the multibody engine
   libsimbody-dev libfcl-dev libccd-dev libbullet-dev

@@ -43,6 +43,28 @@ mkdir -p "$tmp/mixed" && echo old > "$tmp/mixed/points_superovoid.ply"
 expect_rc 2 "$A" errors -i "$tmp/head.csv" --fits "$tmp/fits.json" -o "$tmp/mixed"
 grep -q "points_superovoid.ply' exists" "$tmp/err" || fail "mixed outputs: $(cat "$tmp/err")"
 [ "$(ls "$tmp/mixed")" = "points_superovoid.ply" ] || fail "errors wrote beside an old output: $(ls "$tmp/mixed")"
+# errors killed midway (SIGKILL once its incomplete-marker appears): the
+# folder does not look finished (no summary.json), and the next run without
+# --force finishes it.
+python3 - "$tmp/many.csv" <<'PY'
+import math, random, sys
+random.seed(2)
+with open(sys.argv[1], "w") as f:
+    f.write("x,y,z\n")
+    for _ in range(300000):
+        t, p = random.uniform(0, 1.2), random.uniform(0, 2 * math.pi)
+        f.write(f"{22 * math.sin(t) * math.cos(p)},{22 * math.sin(t) * math.sin(p)},{22 * math.cos(t)}\n")
+PY
+"$A" errors -i "$tmp/many.csv" --fits "$tmp/fits.json" -o "$tmp/killed" -q &
+pid=$!
+for _ in $(seq 1 3000); do [ -e "$tmp/killed/.errors-incomplete" ] && break; sleep 0.01; done
+kill -KILL "$pid"; wait "$pid" 2>/dev/null || true
+[ -e "$tmp/killed/.errors-incomplete" ] || fail "errors finished before it could be killed, or left no marker"
+[ ! -e "$tmp/killed/summary.json" ] || fail "a killed errors run left summary.json: the folder looks finished"
+"$A" errors -i "$tmp/many.csv" --fits "$tmp/fits.json" -o "$tmp/killed" -q || fail "the rerun after a kill did not finish"
+[ -e "$tmp/killed/summary.json" ] && [ ! -e "$tmp/killed/.errors-incomplete" ] || fail "the rerun left the folder unfinished"
+[ -z "$(find "$tmp/killed" -name '.tmp-*')" ] || fail "temporary files left behind"
+
 # Contact pairs far beyond the solver's range (a centre at 1e300, radii of
 # 1e300, crossing needles of axes 1e-9 and 1e9): each row refused by line
 # (a bad row is skipped and named; only bad rows: exit 3 and no output).
@@ -56,4 +78,39 @@ expect_rc 3 "$A" contact --pairs "$pairs" -o "$tmp/far_out.csv"
 for line in 2 3 4; do grep -q "far.csv:$line:" "$tmp/err" || fail "contact row $line not named: $(cat "$tmp/err")"; done
 grep -q "1e-06 to 1e+06 mm\|1e-6 to 1e6 mm" "$tmp/err" || fail "contact: the range is not stated: $(cat "$tmp/err")"
 [ ! -e "$tmp/far_out.csv" ] || fail "contact wrote an output of refused rows"
+# NIfTI files ITK would read silently wrong: a 4-D image (ITK takes the
+# first volume), a pixdim of 0 or NaN (ITK puts 1 mm in its place).
+nifti() {  # nifti PATH DIMS PIXDIMS: an int16 NIfTI-1 file of 500 HU
+  python3 - "$@" <<'PY'
+import struct, sys
+path, dims, pixdim = sys.argv[1], [int(x) for x in sys.argv[2].split(",")], [float(x) for x in sys.argv[3].split(",")]
+hdr = bytearray(348)
+struct.pack_into("<i", hdr, 0, 348)
+struct.pack_into("<8h", hdr, 40, len(dims), *(dims + [1] * (7 - len(dims))))
+struct.pack_into("<hh", hdr, 70, 4, 16)
+struct.pack_into("<8f", hdr, 76, 1.0, *(pixdim + [1.0] * (7 - len(pixdim))))
+struct.pack_into("<ff", hdr, 108, 352.0, 1.0)
+hdr[344:348] = b"n+1\0"
+n = 1
+for d in dims: n *= d
+open(path, "wb").write(bytes(hdr) + bytes(4) + struct.pack("<%dh" % n, *([500] * n)))
+PY
+}
+nifti "$tmp/4d.nii" 8,8,8,2 1,1,1,1
+expect_rc 3 "$A" segment -i "$tmp/4d.nii" -o "$tmp/4d-label.nii.gz"
+grep -q "expected one 3-D volume, found 4-D" "$tmp/err" || fail "4-D: $(cat "$tmp/err")"
+for bad in 0 nan; do
+  nifti "$tmp/pixdim-$bad.nii" 8,8,8 1,$bad,1
+  gzip -kf "$tmp/pixdim-$bad.nii"
+  expect_rc 3 "$A" segment -i "$tmp/pixdim-$bad.nii.gz" -o "$tmp/pixdim-label.nii.gz"
+  grep -q "pixdim\[2\]" "$tmp/err" || fail "pixdim $bad: $(cat "$tmp/err")"
+  [ ! -e "$tmp/pixdim-label.nii.gz" ] || fail "a label was written for pixdim $bad"
+done
+
+# Ranges checked before any work; an unknown command is one, --help or not.
+expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --max-radius 1e6
+grep -q "max-radius (mm): expected 1 to 60" "$tmp/err" || fail "max-radius: $(cat "$tmp/err")"
+expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --close-radius 1000
+expect_rc 2 "$A" nosuch --help
+grep -q "unknown command 'nosuch'" "$tmp/err" || fail "nosuch --help: $(cat "$tmp/err")"
 echo "bad input: ok"

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/core/version.hpp"
@@ -129,6 +130,12 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
     for (auto& command : commands)
       if (command->name() == argv[1])
         return runSingle(argc - 1, argv + 1, std::string("articula ") + argv[1], std::move(command));
+    // A first word that is no option and no command: say so, whatever follows
+    // (`articula nosuch --help` must not print the top-level help with exit 0).
+    if (argv[1][0] != '-') {
+      std::cerr << "articula: error: unknown command '" << excerpt(argv[1]) << "' (run 'articula --help' for the list)\n";
+      return static_cast<int>(ExitCode::UsageError);
+    }
   }
   CLI::App app{"articula: shape analysis of spheroidal joints from CT, and exact contact detection "
                "between smooth convex surfaces. Coordinates are LPS millimetres."};

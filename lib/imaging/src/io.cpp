@@ -12,7 +12,10 @@
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
 #include <itkImage.h>
+#include <cerrno>
+#include <cstdint>
 #include <itkImageFileReader.h>
+#include <zlib.h>
 #include <itkImageFileWriter.h>
 #include <itkImageSeriesReader.h>
 #include <itkImageSeriesWriter.h>
@@ -48,6 +51,57 @@ std::vector<double> parseNumbers(const std::string& text) {
   }
   return out;
 }
+
+}  // namespace
+
+void checkNiftiSpacing(const fs::path& path) {
+  const std::string name = path.filename().string();
+  const auto ends = [&name](const std::string& ext) {
+    return name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  if (!ends(".nii") && !ends(".nii.gz")) return;
+  // zlib reads plain and gzip files alike; the header is the first 348
+  // (NIfTI-1) or 540 (NIfTI-2) bytes, in the file's byte order.
+  gzFile file = gzopen(path.string().c_str(), "rb");
+  if (!file) throw InputError("cannot open '" + path.string() + "': " + std::strerror(errno));
+  unsigned char header[540] = {};
+  const int got = gzread(file, header, sizeof header);
+  gzclose(file);
+  if (got < 348) throw InputError(path.string() + ": expected a NIfTI header of 348 bytes, found " + std::to_string(std::max(got, 0)));
+  const auto int32 = [&header](int at, bool swap) {
+    std::uint32_t v;
+    std::memcpy(&v, header + at, 4);
+    return static_cast<std::int32_t>(swap ? __builtin_bswap32(v) : v);
+  };
+  for (bool swap : {false, true}) {
+    const std::int32_t size = int32(0, swap);
+    if (size != 348 && !(size == 540 && got >= 540)) continue;
+    for (int axis = 1; axis <= 3; ++axis) {
+      double spacing;
+      if (size == 348) {
+        std::uint32_t bits;
+        std::memcpy(&bits, header + 76 + 4 * axis, 4);
+        if (swap) bits = __builtin_bswap32(bits);
+        float f;
+        std::memcpy(&f, &bits, 4);
+        spacing = f;
+      } else {
+        std::uint64_t bits;
+        std::memcpy(&bits, header + 104 + 8 * axis, 8);
+        if (swap) bits = __builtin_bswap64(bits);
+        std::memcpy(&spacing, &bits, 8);
+      }
+      if (!(std::isfinite(spacing) && spacing != 0))
+        throw InputError(path.string() + ": the NIfTI header's pixdim[" + std::to_string(axis) +
+                         "] (voxel size along axis " + std::to_string(axis) + ") is " + std::to_string(spacing) +
+                         "; expected a non-zero, finite size in mm");
+    }
+    return;
+  }
+  throw InputError(path.string() + ": not a NIfTI file (its header size is neither 348 nor 540 in either byte order)");
+}
+
+namespace {
 
 /// Modality and description of a series from its first file's header.
 void readHeader(const std::string& file, std::string& modality, std::string& description) {

@@ -2,12 +2,15 @@
 // Private to lib/imaging: copies between the plain Image<T> and itk::Image<T, 3>
 // (buffers are both i-fastest, so a straight copy), and ITK file I/O.
 // Include after articula/imaging/image.hpp (system Eigen before ITK's bundled one).
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <unistd.h>
 
 #include <itkImage.h>
 #include <itkImageFileReader.h>
+#include <itkImageIOFactory.h>
 #include <itkImageFileWriter.h>
 
 #include "articula/core/atomic_file.hpp"
@@ -66,8 +69,36 @@ Image<T> fromItk(const itk::Image<U, 3>* image) {
   return out;
 }
 
+/// Throws InputError when a NIfTI file's own header (not ITK's reading of
+/// it, which puts 1 mm in place of a pixdim of 0 or NaN) gives a spatial
+/// voxel size that is not a positive finite number. Other formats: no-op.
+void checkNiftiSpacing(const std::filesystem::path& path);
+
 template <typename T>
 Image<T> readImageFile(const std::filesystem::path& path) {
+  checkNiftiSpacing(path);
+  // What the file holds, before ITK reads it as 3-D (it would silently take
+  // the first volume of a 4-D image and the first component of a vector).
+  if (auto io = itk::ImageIOFactory::CreateImageIO(path.string().c_str(), itk::CommonEnums::IOFileMode::ReadMode)) {
+    try {
+      io->SetFileName(path.string());
+      io->ReadImageInformation();
+    } catch (const itk::ExceptionObject& e) {
+      throw InputError("could not read the image header of " + path.string() + ": " + e.GetDescription());
+    }
+    for (unsigned d = 3; d < io->GetNumberOfDimensions(); ++d)
+      if (io->GetDimensions(d) > 1)
+        throw InputError(path.string() + ": expected one 3-D volume, found " + std::to_string(io->GetNumberOfDimensions()) +
+                         "-D data with " + std::to_string(io->GetDimensions(d)) + " elements along dimension " +
+                         std::to_string(d + 1));
+    if (io->GetNumberOfComponents() > 1)
+      throw InputError(path.string() + ": expected one value per voxel, found " + std::to_string(io->GetNumberOfComponents()) +
+                       " components");
+    for (unsigned d = 0; d < std::min(3u, io->GetNumberOfDimensions()); ++d)
+      if (!(io->GetSpacing(d) > 0) || !std::isfinite(io->GetSpacing(d)))
+        throw InputError(path.string() + ": expected a voxel spacing > 0 mm, found " + std::to_string(io->GetSpacing(d)) +
+                         " along axis " + std::to_string(d + 1));
+  }
   auto reader = itk::ImageFileReader<itk::Image<T, 3>>::New();
   reader->SetFileName(path.string());
   try {

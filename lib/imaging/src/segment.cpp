@@ -588,18 +588,31 @@ Mask refineByLevelSet(const Volume& hu, const Mask& head, int iterations) {
 }  // namespace
 
 void SegmentOptions::validate() const {
+  // Ranges that keep the work bounded: joint heads are 15-35 mm in radius
+  // (60 mm leaves room for any animal or implant study), the closing and the
+  // gap filter act on millimetres, the search grid on a few voxels.
+  const auto range = [](double v, double lo, double hi, const std::string& what) {
+    if (!(v >= lo && v <= hi)) {
+      std::ostringstream m;
+      m << what << ": expected " << lo << " to " << hi << ", found " << v;
+      throw UsageError(m.str());
+    }
+  };
+  range(hu_min, -2000, 10000, "--hu-min (HU)");
+  range(hu_max, -2000, 40000, "--hu-max (HU)");
   if (!(hu_min < hu_max)) throw UsageError("--hu-min must be below --hu-max");
   if (roi_min.has_value() != roi_max.has_value()) throw UsageError("--roi needs both corners");
   if (roi_min && (roi_max->array() <= roi_min->array()).any())
     throw UsageError("--roi: expected xmin,ymin,zmin,xmax,ymax,zmax with min < max");
-  if (!(min_head_radius_mm > 0 && min_head_radius_mm < max_head_radius_mm))
-    throw UsageError("head radius range must satisfy 0 < min < max");
-  if (!(search_spacing_mm > 0)) throw UsageError("search spacing must be > 0");
-  if (!(close_radius_mm >= 0)) throw UsageError("--close-radius must be >= 0");
-  if (level_set_iterations < 0) throw UsageError("--level-set must be >= 0 iterations");
-  if (!(midline_margin_mm >= 0 || midline_margin_mm == -1))
-    throw UsageError("--midline-margin must be >= 0 mm, or -1 for automatic");
-  if (!(min_coverage >= 0 && min_coverage <= 1)) throw UsageError("--min-coverage must lie in [0, 1]");
+  range(min_head_radius_mm, 1, 60, "--min-radius (mm)");
+  range(max_head_radius_mm, 1, 60, "--max-radius (mm)");
+  if (!(min_head_radius_mm < max_head_radius_mm)) throw UsageError("head radius range must satisfy min < max");
+  range(search_spacing_mm, 0.5, 10, "search spacing (mm)");
+  range(close_radius_mm, 0, 20, "--close-radius (mm)");
+  range(gap_width_mm, 0.5, 20, "joint gap width (mm)");
+  if (level_set_iterations < 0 || level_set_iterations > 10000) throw UsageError("--level-set: expected 0 to 10000 iterations");
+  if (!(midline_margin_mm == -1)) range(midline_margin_mm, 0, 500, "--midline-margin (mm; -1: automatic)");
+  range(min_coverage, 0, 1, "--min-coverage");
 }
 
 Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSummary* summary_out) {
