@@ -75,11 +75,11 @@ std::string number(double v) {
   return s.str();
 }
 
-// Parameter names with units, for results and study tables.
-std::string withUnit(const std::string& name) {
-  if (name == "a" || name == "b" || name == "c" || name == "t1" || name == "t2" || name == "t3") return name + "_mm";
-  if (name == "phi" || name == "theta" || name == "psi") return name + "_deg";
-  return name;
+// Parameter names with units, for results and study tables (angles in degrees).
+std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
+  if (kind == geometry::ParameterKind::Angle) return name + "_deg";
+  const std::string unit = geometry::parameterUnit(kind);
+  return unit.empty() ? name : name + "_" + unit;
 }
 
 class RunCommand : public cli::Command {
@@ -243,12 +243,13 @@ class RunCommand : public cli::Command {
       const std::string name = geometry::modelName(shape.model);
       if (name == best) best_shape = shape;
       const auto names = geometry::parameterNames(shape.model);
+      const auto kinds = geometry::parameterKinds(shape.model);
       const Eigen::VectorXd lambda = geometry::toVector(shape);
       json parameters = json::object();
       for (size_t i = 0; i < names.size(); ++i) {
         double v = lambda[static_cast<Eigen::Index>(i)];
-        if (names[i] == "phi" || names[i] == "theta" || names[i] == "psi") v *= 180.0 / M_PI;
-        parameters[withUnit(names[i])] = v;
+        if (kinds[i] == geometry::ParameterKind::Angle) v *= 180.0 / M_PI;
+        parameters[withUnit(names[i], kinds[i])] = v;
       }
       json errors = errors_by_model.count(name) ? errors_by_model[name] : json::object();
       errors.erase("model");

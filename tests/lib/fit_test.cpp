@@ -257,3 +257,49 @@ TEST(FitHierarchy, RejectsBadOptionsAndTooFewPoints) {
 }
 
 }  // namespace
+
+// --bounds: every fitted parameter a bound names stays inside it, even where
+// the parent's optimum lies outside (the start is clamped in, the nesting
+// guarantee yields); a bound excluding the free optimum changes the answer.
+TEST(FitHierarchy, UserBoundsAreHonoured) {
+  const ShapeParameters truth = trueShape(ShapeModel::Superellipsoid);  // gamma1 2.4, theta -0.3
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(truth, 90.0 * M_PI / 180.0, 800, 0.0, 7);
+  Options free_fit;
+  free_fit.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid, ShapeModel::Superellipsoid};
+  const Summary a = articula::fit::fitHierarchy(pts, free_fit);
+  Options bounded = free_fit;
+  bounded.bounds = {{"gamma1", {2.05, 2.15}}, {"gamma3", {2.0, 2.1}}, {"theta", {0.2, 0.5}}};
+  const Summary b = articula::fit::fitHierarchy(pts, bounded);
+  for (ShapeModel m : {ShapeModel::Ellipsoid, ShapeModel::Superellipsoid}) {
+    const ShapeParameters p = b.fit(m).parameters;
+    const auto names = articula::geometry::parameterNames(m);
+    const Eigen::VectorXd x = articula::geometry::toVector(p);
+    for (size_t k = 0; k < names.size(); ++k)
+      if (auto it = bounded.bounds.find(names[k]); it != bounded.bounds.end()) {
+        EXPECT_GE(x[static_cast<Eigen::Index>(k)], it->second.first - 1e-9) << names[k];
+        EXPECT_LE(x[static_cast<Eigen::Index>(k)], it->second.second + 1e-9) << names[k];
+      }
+  }
+  EXPECT_LT(a.fit(ShapeModel::Superellipsoid).rms_mm, 0.01);  // free: the exact surface
+  EXPECT_GT(b.fit(ShapeModel::Superellipsoid).rms_mm, 0.05);  // the bounds exclude it
+}
+
+TEST(ParameterKinds, OneKindPerParameterAndNoneTakenForAnother) {
+  for (ShapeModel m : articula::geometry::allModels()) {
+    const auto names = articula::geometry::parameterNames(m);
+    const auto kinds = articula::geometry::parameterKinds(m);
+    ASSERT_EQ(names.size(), kinds.size());
+    for (size_t k = 0; k < names.size(); ++k) {
+      using K = articula::geometry::ParameterKind;
+      const std::string& n = names[k];
+      const K expected = n == "a" || n == "b" || n == "c"                       ? K::Radius
+                         : n == "t1" || n == "t2" || n == "t3"                  ? K::Translation
+                         : n == "phi" || n == "theta" || n == "psi"             ? K::Angle
+                         : n.size() == 6 && n.substr(0, 5) == "gamma"           ? K::Exponent
+                         : n == "c0x" || n == "c1x" || n == "c0y" || n == "c1y" ? K::OvoidScale
+                                                                                : K::OvoidCurvature;
+      EXPECT_EQ(kinds[k], expected) << articula::geometry::modelName(m) << " " << n;
+    }
+  }
+  EXPECT_EQ(articula::geometry::parameterUnit(articula::geometry::ParameterKind::Angle), "rad");
+}

@@ -96,7 +96,10 @@ using Clock = std::chrono::steady_clock;
 
 struct Bounds {
   VectorXd lower, upper;
+  std::vector<char> given;  // set by the user (Options::bounds): never widened, the start clamped into it
 };
+
+using geometry::ParameterKind;
 
 // Parameter bounds of thesis section 3.2.5 around the reference start.
 Bounds makeBounds(ShapeModel model, const ShapeParameters& reference, const ShapeParameters& sphere,
@@ -104,35 +107,45 @@ Bounds makeBounds(ShapeModel model, const ShapeParameters& reference, const Shap
   const double r_min = std::min(reference.radii.minCoeff(), sphere.radii[0]);
   const double r_max = std::max(reference.radii.maxCoeff(), sphere.radii[0]);
   const auto names = geometry::parameterNames(model);
-  Bounds b{VectorXd(names.size()), VectorXd(names.size())};
+  const auto kinds = geometry::parameterKinds(model);
+  Bounds b{VectorXd(names.size()), VectorXd(names.size()), std::vector<char>(names.size(), 0)};
+  int translation_axis = 0;
   for (size_t k = 0; k < names.size(); ++k) {
-    const std::string& n = names[k];
     const Eigen::Index i = static_cast<Eigen::Index>(k);
     double lo = 0.0, hi = 0.0;
-    if (n == "a" || n == "b" || n == "c") {
-      lo = (1.0 - o.radius_interval) * r_min;
-      hi = (1.0 + o.radius_interval) * r_max;
-    } else if (n.rfind("gamma", 0) == 0) {
-      lo = o.exponent_min;
-      hi = o.exponent_max;
-    } else if (n[0] == 'c' && (n[1] == '0' || n[1] == '1')) {
-      lo = o.c01_min;
-      hi = o.c01_max;
-    } else if (n[0] == 'c') {
-      lo = o.c23_min;
-      hi = o.c23_max;
-    } else if (n == "t1" || n == "t2" || n == "t3") {  // not "theta"
-      const int axis = n[1] - '1';
-      lo = std::min(reference.center[axis], sphere.center[axis]) - o.center_interval * r_max;
-      hi = std::max(reference.center[axis], sphere.center[axis]) + o.center_interval * r_max;
-    } else {
-      // Angles: set per run to start +- pi (a full turn, so wrapping never blocks).
-      lo = -std::numeric_limits<double>::infinity();
-      hi = std::numeric_limits<double>::infinity();
+    switch (kinds[k]) {
+      case ParameterKind::Radius:
+        lo = (1.0 - o.radius_interval) * r_min;
+        hi = (1.0 + o.radius_interval) * r_max;
+        break;
+      case ParameterKind::Exponent:
+        lo = o.exponent_min;
+        hi = o.exponent_max;
+        break;
+      case ParameterKind::OvoidScale:
+        lo = o.c01_min;
+        hi = o.c01_max;
+        break;
+      case ParameterKind::OvoidCurvature:
+        lo = o.c23_min;
+        hi = o.c23_max;
+        break;
+      case ParameterKind::Translation: {
+        const int axis = translation_axis++;
+        lo = std::min(reference.center[axis], sphere.center[axis]) - o.center_interval * r_max;
+        hi = std::max(reference.center[axis], sphere.center[axis]) + o.center_interval * r_max;
+        break;
+      }
+      case ParameterKind::Angle:
+        // Set per run to start +- pi (a full turn, so wrapping never blocks).
+        lo = -std::numeric_limits<double>::infinity();
+        hi = std::numeric_limits<double>::infinity();
+        break;
     }
-    if (auto it = o.bounds.find(n); it != o.bounds.end()) {
+    if (auto it = o.bounds.find(names[k]); it != o.bounds.end()) {
       lo = it->second.first;
       hi = it->second.second;
+      b.given[k] = 1;
     }
     b.lower[i] = lo;
     b.upper[i] = hi;
@@ -142,17 +155,20 @@ Bounds makeBounds(ShapeModel model, const ShapeParameters& reference, const Shap
 
 // Initial trust-region steps, in each parameter's own units.
 VectorXd initialSteps(ShapeModel model, const ShapeParameters& start) {
-  const auto names = geometry::parameterNames(model);
-  VectorXd step(names.size());
+  const auto kinds = geometry::parameterKinds(model);
+  VectorXd step(static_cast<Eigen::Index>(kinds.size()));
   const double r = start.radii.maxCoeff();
-  for (size_t k = 0; k < names.size(); ++k) {
-    const std::string& n = names[k];
-    const Eigen::Index i = static_cast<Eigen::Index>(k);
-    if (n == "a" || n == "b" || n == "c") step[i] = 0.02 * r;
-    else if (n[0] == 't') step[i] = 0.02 * r;
-    else if (n.rfind("gamma", 0) == 0) step[i] = 0.05;
-    else if (n[0] == 'c') step[i] = 0.01;
-    else step[i] = 0.05;  // angles (rad)
+  for (size_t k = 0; k < kinds.size(); ++k) {
+    double s = 0.05;  // angles (rad)
+    switch (kinds[k]) {
+      case ParameterKind::Radius:
+      case ParameterKind::Translation: s = 0.02 * r; break;
+      case ParameterKind::Exponent: s = 0.05; break;
+      case ParameterKind::OvoidScale:
+      case ParameterKind::OvoidCurvature: s = 0.01; break;
+      case ParameterKind::Angle: s = 0.05; break;
+    }
+    step[static_cast<Eigen::Index>(k)] = s;
   }
   return step;
 }
@@ -369,10 +385,10 @@ RunResult runLocal(ShapeModel model, const VectorXd& start, const Bounds& bounds
 }
 
 Bounds boundsForStart(Bounds b, ShapeModel model, const VectorXd& start) {
-  const auto names = geometry::parameterNames(model);
+  const auto kinds = geometry::parameterKinds(model);
   for (Eigen::Index i = 0; i < start.size(); ++i) {
-    const std::string& n = names[static_cast<size_t>(i)];
-    if (n == "phi" || n == "theta" || n == "psi") {
+    if (b.given[static_cast<size_t>(i)]) continue;  // the user's box, as given (the start is clamped into it)
+    if (kinds[static_cast<size_t>(i)] == ParameterKind::Angle) {
       b.lower[i] = start[i] - M_PI;
       b.upper[i] = start[i] + M_PI;
     }
@@ -412,6 +428,8 @@ std::vector<OvoidAxis> holdableOvoidAxes(ShapeModel model, const Bounds& b) {
 // A start of `model` as a vector with its bounds, the ovoid radii held (above).
 std::pair<VectorXd, Bounds> prepareStart(ShapeModel model, const ShapeParameters& start, const Bounds& model_bounds) {
   VectorXd x0 = geometry::toVector(geometry::promote(start, model));
+  for (Eigen::Index i = 0; i < x0.size(); ++i)
+    if (model_bounds.given[static_cast<size_t>(i)]) x0[i] = std::clamp(x0[i], model_bounds.lower[i], model_bounds.upper[i]);
   Bounds b = boundsForStart(model_bounds, model, x0);
   for (const OvoidAxis& a : holdableOvoidAxes(model, b)) {
     const double factor = x0[a.radius] / b.upper[a.radius];
@@ -644,11 +662,16 @@ ShapeParameters combineParents(const ShapeParameters& superellipsoid, const Shap
 }
 
 // The nesting guarantee: a child never reports a worse RMS than its parent.
-void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::MatrixX3d& points) {
+// Not where the user's bounds exclude the parent (then the child answers
+// within them, even if the parent fits better).
+void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::MatrixX3d& points, const Bounds& bounds) {
   ModelFit& child = fitted.fit;
   const ModelFit& parent = parent_fitted.fit;
   if (child.rms_mm <= parent.rms_mm) return;
   const ShapeModel model = child.parameters.model;
+  const VectorXd promoted = geometry::toVector(geometry::promote(parent.parameters, model));
+  for (Eigen::Index i = 0; i < promoted.size(); ++i)
+    if (bounds.given[static_cast<size_t>(i)] && !(promoted[i] >= bounds.lower[i] && promoted[i] <= bounds.upper[i])) return;
   child.parameters = geometry::promote(parent.parameters, model);
   child.rms_mm = exactRms(child.parameters, points, child.sse_mm2, fitted.feet);
   child.algebraic_objective = algebraicObjective(child.parameters, points);
@@ -709,7 +732,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   if (have_algebraic_ellipsoid) e_starts.push_back({"algebraic", ellipsoid_start, {}});
   Fitted ellipsoid =
       fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o, o.screening_evaluations);
-  enforceNesting(ellipsoid, sphere, points);
+  enforceNesting(ellipsoid, sphere, points, bounds(ShapeModel::Ellipsoid));
 
   auto wanted = [&](ShapeModel m) { return std::find(o.models.begin(), o.models.end(), m) != o.models.end(); };
   const bool need_se = wanted(ShapeModel::Superellipsoid) || wanted(ShapeModel::Superovoid);
@@ -718,12 +741,12 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   if (need_se) {
     superellipsoid = fitModel(ShapeModel::Superellipsoid, superellipsoidStarts(ellipsoid),
                               bounds(ShapeModel::Superellipsoid), points, o, o.screening_evaluations);
-    enforceNesting(superellipsoid, ellipsoid, points);
+    enforceNesting(superellipsoid, ellipsoid, points, bounds(ShapeModel::Superellipsoid));
   }
   if (need_o) {
     ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(ellipsoid), bounds(ShapeModel::Ovoid), points, o,
                      o.screening_evaluations);
-    enforceNesting(ovoid, ellipsoid, points);
+    enforceNesting(ovoid, ellipsoid, points, bounds(ShapeModel::Ovoid));
   }
   if (wanted(ShapeModel::Superovoid)) {
     // Every labelling of the superellipsoid: which axis the asymmetry takes
@@ -734,7 +757,8 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
                          combineParents(superellipsoid.fit.parameters, ovoid.fit.parameters), {}});
     superovoid = fitModel(ShapeModel::Superovoid, so_starts, bounds(ShapeModel::Superovoid), points, o,
                           o.screening_evaluations);
-    enforceNesting(superovoid, superellipsoid.fit.rms_mm <= ovoid.fit.rms_mm ? superellipsoid : ovoid, points);
+    enforceNesting(superovoid, superellipsoid.fit.rms_mm <= ovoid.fit.rms_mm ? superellipsoid : ovoid, points,
+                   bounds(ShapeModel::Superovoid));
   }
 
   Summary summary;

@@ -38,6 +38,29 @@ bool hasOvoidCoefficients(ShapeModel m) { return m == ShapeModel::Ovoid || m == 
 bool hasOrientation(ShapeModel m) { return m != ShapeModel::Sphere; }
 }  // namespace
 
+std::vector<ParameterKind> parameterKinds(ShapeModel m) {
+  std::vector<ParameterKind> kinds = {ParameterKind::Radius};
+  if (m != ShapeModel::Sphere) kinds.insert(kinds.end(), 2, ParameterKind::Radius);
+  if (hasExponents(m)) kinds.insert(kinds.end(), 3, ParameterKind::Exponent);
+  if (hasOvoidCoefficients(m))
+    for (int axis = 0; axis < 2; ++axis) {
+      kinds.insert(kinds.end(), 2, ParameterKind::OvoidScale);
+      kinds.insert(kinds.end(), 2, ParameterKind::OvoidCurvature);
+    }
+  kinds.insert(kinds.end(), 3, ParameterKind::Translation);
+  if (hasOrientation(m)) kinds.insert(kinds.end(), 3, ParameterKind::Angle);
+  return kinds;
+}
+
+std::string parameterUnit(ParameterKind kind) {
+  switch (kind) {
+    case ParameterKind::Radius:
+    case ParameterKind::Translation: return "mm";
+    case ParameterKind::Angle: return "rad";
+    default: return "";
+  }
+}
+
 int parameterCount(ShapeModel m) { return static_cast<int>(parameterNames(m).size()); }
 
 std::vector<std::string> parameterNames(ShapeModel m) {

@@ -36,6 +36,21 @@ struct ShapeParameters {
 int parameterCount(ShapeModel model);
 /// Names in table 3.2 order, e.g. {"a","b","c","gamma1",...,"t1","t2","t3","phi","theta","psi"}.
 std::vector<std::string> parameterNames(ShapeModel model);
+
+/// What a parameter of thesis table 3.2 is, for the code that bounds,
+/// steps, converts or labels it (never by the letters of its name).
+enum class ParameterKind {
+  Radius,           // a, b, c (mm)
+  Exponent,         // gamma1..3
+  OvoidScale,       // c0x, c1x, c0y, c1y: the ovoid's constant and linear terms
+  OvoidCurvature,   // c2x, c3x, c2y, c3y: its quadratic and cubic terms
+  Translation,      // t1..3 (mm)
+  Angle,            // phi, theta, psi (rad)
+};
+/// The kind of each parameter, in the order of parameterNames(model).
+std::vector<ParameterKind> parameterKinds(ShapeModel model);
+/// "mm", "rad" or "" (dimensionless).
+std::string parameterUnit(ParameterKind kind);
 /// The parameter vector lambda of table 3.2 (angles in radians).
 Eigen::VectorXd toVector(const ShapeParameters& p);
 /// Inverse of toVector; throws UsageError if the length is not parameterCount(model).
