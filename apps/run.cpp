@@ -239,7 +239,9 @@ class RunCommand : public cli::Command {
     std::vector<std::string> csv_header = {"model", "n_parameters", "aic", "bic", "best_by_rms"};
     std::string csv_rows;
     geometry::ShapeParameters best_shape = shapes.front();
-    for (const auto& shape : shapes) {
+    for (size_t model_index = 0; model_index < shapes.size(); ++model_index) {
+      const geometry::ShapeParameters& shape = shapes[model_index];
+      const json& fit_entry = fits.at("models")[model_index];
       const std::string name = geometry::modelName(shape.model);
       if (name == best) best_shape = shape;
       const auto names = geometry::parameterNames(shape.model);
@@ -257,6 +259,19 @@ class RunCommand : public cli::Command {
       const int n = errors.value("n_points", 0);
       const double sse = errors.value("sse_mm2", 0.0);
       json entry = {{"model", name}, {"n_parameters", k}, {"parameters", parameters}, {"errors", errors}};
+      // Standard errors in the parameters' units (angles in degrees); null:
+      // not identifiable from these points (fits.json, fit/uncertainty.hpp).
+      if (fit_entry.contains("standard_errors_table_3_2")) {
+        json standard_errors = json::object();
+        const json& se = fit_entry.at("standard_errors_table_3_2");
+        for (size_t i = 0; i < names.size(); ++i) {
+          json v = se.value(names[i], json(nullptr));
+          if (v.is_number() && kinds[i] == geometry::ParameterKind::Angle) v = v.get<double>() * 180.0 / M_PI;
+          standard_errors[withUnit(names[i], kinds[i])] = v;
+        }
+        entry["standard_errors"] = standard_errors;
+        entry["not_identifiable"] = fit_entry.value("not_identifiable", json::array());
+      }
       if (n > k && sse > 0) {
         entry["aic"] = pipeline::aic(sse, n, k);
         entry["bic"] = pipeline::bic(sse, n, k);

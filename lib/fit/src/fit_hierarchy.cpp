@@ -764,7 +764,10 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   Summary summary;
   summary.points = static_cast<int>(points.rows());
   for (const Fitted* f : std::initializer_list<const Fitted*>{&sphere, &ellipsoid, &superellipsoid, &ovoid, &superovoid})
-    if (wanted(f->fit.parameters.model) && f->fit.evaluations > 0) summary.fits.push_back(f->fit);
+    if (wanted(f->fit.parameters.model) && f->fit.evaluations > 0) {
+      summary.fits.push_back(f->fit);
+      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points);
+    }
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)
     if (f.rms_mm < best_rms - 1e-9) {

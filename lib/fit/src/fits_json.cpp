@@ -41,6 +41,16 @@ nlohmann::json modelFitJson(const ModelFit& f) {
   const auto names = geometry::parameterNames(p.model);
   const Eigen::VectorXd lambda = geometry::toVector(p);
   for (size_t i = 0; i < names.size(); ++i) parameters[names[i]] = lambda[static_cast<Eigen::Index>(i)];
+  // Standard errors and 95 % intervals (null: not identifiable from these points).
+  const ParameterUncertainty& u = f.uncertainty;
+  nlohmann::json errors = nlohmann::json::object(), intervals = nlohmann::json::object();
+  const auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  if (u.standard_error.size() == static_cast<Eigen::Index>(names.size()))
+    for (size_t i = 0; i < names.size(); ++i) {
+      const auto k = static_cast<Eigen::Index>(i);
+      errors[names[i]] = finite(u.standard_error[k]);
+      intervals[names[i]] = std::isfinite(u.standard_error[k]) ? nlohmann::json{u.ci95_lower[k], u.ci95_upper[k]} : nlohmann::json(nullptr);
+    }
   return {{"model", geometry::modelName(p.model)},
           {"center_mm", list(p.center)},
           {"radii_mm", list(radii)},
@@ -51,6 +61,10 @@ nlohmann::json modelFitJson(const ModelFit& f) {
           {"cx", list(p.cx)},
           {"cy", list(p.cy)},
           {"parameters_table_3_2", parameters},
+          {"standard_errors_table_3_2", errors},
+          {"ci95_table_3_2", intervals},
+          {"not_identifiable", u.not_identifiable},
+          {"condition_number", finite(u.condition_number)},
           {"rms_mm", f.rms_mm},
           {"geometric_objective_mm2", f.sse_mm2},
           {"algebraic_objective", f.algebraic_objective},

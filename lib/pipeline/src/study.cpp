@@ -101,6 +101,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   header.insert(header.end(), kErrorColumns.begin(), kErrorColumns.end());
   header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected", "qc_status", "qc_reasons"});
   header.insert(header.end(), parameter_columns.begin(), parameter_columns.end());
+  for (const auto& c : parameter_columns) header.push_back(c + "_se");  // standard errors, same units
   std::string study_csv = csvLine(header) + "\n";
   for (const auto& r : rows) {
     std::vector<std::string> f = {r.subject, r.model, number(r.entry.value("n_parameters", 0))};
@@ -113,6 +114,9 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     f.push_back(r.qc_reasons);
     for (const auto& c : parameter_columns)
       f.push_back(r.entry.at("parameters").contains(c) ? number(r.entry.at("parameters").at(c).get<double>()) : "");
+    const nlohmann::json se = r.entry.value("standard_errors", nlohmann::json::object());
+    for (const auto& c : parameter_columns)
+      f.push_back(se.contains(c) && se.at(c).is_number() ? number(se.at(c).get<double>()) : "");
     study_csv += csvLine(f) + "\n";
   }
 

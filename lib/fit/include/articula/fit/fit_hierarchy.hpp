@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "articula/fit/uncertainty.hpp"
 #include "articula/geometry/shape.hpp"
 
 namespace articula::fit {
@@ -79,6 +80,7 @@ struct ModelFit {
   double seconds = 0.0;
   std::string termination;         // NLopt's reason, or why the parent was kept
   bool converged = false;
+  ParameterUncertainty uncertainty;  // at the result (uncertainty.hpp)
 };
 
 struct Summary {
