@@ -97,6 +97,7 @@ class FitCommand : public cli::Command {
     if (output_.extension() != ".json") throw UsageError("--output: expected a .json file, found '" + output_.string() + "'");
     const std::filesystem::path csv = std::filesystem::path(output_).replace_extension(".csv");
     refuseOutputsOverInputs({output_, csv}, {input_, bounds_file_});
+    checkOutputTarget(output_);
     for (const auto& path : {output_, csv})
       if (std::filesystem::exists(path) && !common.force)
         throw UsageError("output '" + path.string() + "' exists (use --force to overwrite)");

@@ -51,6 +51,7 @@ class MeshCommand : public cli::Command {
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
     snap_.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
+    checkOutputTarget(output_);
     const imaging::Label label = imaging::readLabel(input_);
     mesh::MeshSummary s;
     mesh::TriangleMesh m = mesh::extractSurface(label, options_, &s);

@@ -144,6 +144,8 @@ class RunCommand : public cli::Command {
         if (rc != 0) return rc;  // the stage has said why on stderr
       }
       stamp["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      stamp["outputs"] = json::object();  // a damaged or replaced output reruns the stage
+      for (const auto& out : plan.outputs) stamp["outputs"][out.string()] = hashInput(out);
       writeFileAtomically(stamp_path, stamp.dump(2) + "\n");
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -214,7 +216,10 @@ class RunCommand : public cli::Command {
     if (!in) return false;
     try {
       const json old = json::parse(in);
-      return old.at("args") == stamp.at("args") && old.at("inputs") == stamp.at("inputs");
+      if (!(old.at("args") == stamp.at("args") && old.at("inputs") == stamp.at("inputs"))) return false;
+      for (const auto& out : plan.outputs)
+        if (old.at("outputs").value(out.string(), "") != hashInput(out)) return false;
+      return true;
     } catch (const json::exception&) {
       return false;
     }

@@ -49,6 +49,7 @@ class SampleCommand : public cli::Command {
     const std::string ext = output_.extension().string();
     if (ext != ".ply" && ext != ".csv") throw UsageError("--output: expected a .ply or .csv file, found '" + output_.string() + "'");
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
+    checkOutputTarget(output_);
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
 

@@ -59,6 +59,7 @@ class SegmentCommand : public cli::Command {
     }
     options_.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
+    checkOutputTarget(output_);
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
 

@@ -65,6 +65,14 @@ kill -KILL "$pid"; wait "$pid" 2>/dev/null || true
 [ -e "$tmp/killed/summary.json" ] && [ ! -e "$tmp/killed/.errors-incomplete" ] || fail "the rerun left the folder unfinished"
 [ -z "$(find "$tmp/killed" -name '.tmp-*')" ] || fail "temporary files left behind"
 
+# An output that cannot be written: exit 1 naming it and the system's reason, before any work.
+mkdir -p "$tmp/dir.json"
+expect_rc 1 "$A" fit -i "$tmp/head.csv" -o "$tmp/dir.json"
+grep -q "it is a folder" "$tmp/err" || fail "-o a folder: $(cat "$tmp/err")"
+touch "$tmp/notafolder"
+expect_rc 1 "$A" fit -i "$tmp/head.csv" -o "$tmp/notafolder/fits.json"
+grep -q "cannot create the folder" "$tmp/err" || fail "-o under a file: $(cat "$tmp/err")"
+
 # Contact pairs far beyond the solver's range (a centre at 1e300, radii of
 # 1e300, crossing needles of axes 1e-9 and 1e9): each row refused by line
 # (a bad row is skipped and named; only bad rows: exit 3 and no output).

@@ -53,4 +53,18 @@ else
   [ "$rc" -eq 1 ] || fail "coarse voxels: exit $rc"
   grep -q "qc\|no femoral head" "$tmp/coarse.err" || fail "coarse voxels: refused without a reason: $(cat "$tmp/coarse.err")"
 fi
+# A damaged output of an up-to-date stage is redone, not kept.
+# (Each stage's stamp holds its run time: a stage redone writes a new one.)
+cp "$tmp/left-run/results.json" "$tmp/left-results.json"
+cp "$tmp/left-run/.articula/segment.json" "$tmp/segment-stamp.json"
+cp "$tmp/left-run/.articula/sample.json" "$tmp/sample-stamp.json"
+echo "damaged" > "$tmp/left-run/points.ply"
+"$bin/articula" run -i "$tmp/left/phantom.nii.gz" -o "$tmp/left-run" --side left -q
+cmp -s "$tmp/segment-stamp.json" "$tmp/left-run/.articula/segment.json" || fail "an intact stage (segment) was redone"
+if cmp -s "$tmp/sample-stamp.json" "$tmp/left-run/.articula/sample.json"; then fail "the damaged points.ply was kept"; fi
+python3 - "$tmp/left-results.json" "$tmp/left-run/results.json" <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+assert [m["errors"]["rms_mm"] for m in a["models"]] == [m["errors"]["rms_mm"] for m in b["models"]], "results changed"
+PY
 echo "head isolation: ok"

@@ -1,7 +1,11 @@
 #include "articula/core/output_paths.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <system_error>
+
+#include <unistd.h>
 
 #include "articula/core/error.hpp"
 
@@ -34,6 +38,18 @@ void refuseOutputsOverInputs(const std::vector<fs::path>& outputs, const std::ve
         throw UsageError("output '" + out.string() + "' would overwrite the input '" + in.string() +
                          "': choose another output name");
     }
+}
+
+void checkOutputTarget(const fs::path& output) {
+  std::error_code ec;
+  if (fs::is_directory(output, ec))
+    throw ProcessingError("cannot write '" + output.string() + "': it is a folder, expected a file name");
+  fs::path folder = output.parent_path();
+  if (folder.empty()) folder = ".";
+  fs::create_directories(folder, ec);
+  if (ec) throw ProcessingError("cannot create the folder '" + folder.string() + "' for '" + output.string() + "': " + ec.message());
+  if (::access(folder.c_str(), W_OK) != 0)
+    throw ProcessingError("cannot write into '" + folder.string() + "' (for '" + output.string() + "'): " + std::strerror(errno));
 }
 
 }  // namespace articula

@@ -12,4 +12,10 @@ namespace articula {
 void refuseOutputsOverInputs(const std::vector<std::filesystem::path>& outputs,
                              const std::vector<std::filesystem::path>& inputs);
 
+/// Throws ProcessingError (exit 1) naming the target and the system's reason
+/// when `output` cannot be written: it is a folder, or its folder does not
+/// exist and cannot be made, or is not writable. Checked before the work, so
+/// that an unwritable target does not cost a whole run. Creates the folder.
+void checkOutputTarget(const std::filesystem::path& output);
+
 }  // namespace articula
