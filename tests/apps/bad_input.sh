@@ -4,16 +4,19 @@
 source "$(dirname "$0")/common.bash"
 A="$bin/articula"
 
-# Points of a 22 mm sphere cap.
-python3 - "$tmp/head.csv" <<'PY'
+# cap_points FILE N SEED: N points of a 22 mm sphere cap (CSV).
+cap_points() {
+  python3 - "$@" <<'PY'
 import math, random, sys
-random.seed(1)
+random.seed(int(sys.argv[3]))
 with open(sys.argv[1], "w") as f:
     f.write("x,y,z\n")
-    for _ in range(300):
+    for _ in range(int(sys.argv[2])):
         t, p = random.uniform(0, 1.2), random.uniform(0, 2 * math.pi)
         f.write(f"{22 * math.sin(t) * math.cos(p)},{22 * math.sin(t) * math.sin(p)},{22 * math.cos(t)}\n")
 PY
+}
+cap_points "$tmp/head.csv" 300 1
 cp "$tmp/head.csv" "$tmp/head.orig"
 
 # An output that is an input: fit's table beside head.json would be head.csv, the input.
@@ -46,15 +49,7 @@ grep -q "points_superovoid.ply' exists" "$tmp/err" || fail "mixed outputs: $(cat
 # errors killed midway (SIGKILL once its incomplete-marker appears): the
 # folder does not look finished (no summary.json), and the next run without
 # --force finishes it.
-python3 - "$tmp/many.csv" <<'PY'
-import math, random, sys
-random.seed(2)
-with open(sys.argv[1], "w") as f:
-    f.write("x,y,z\n")
-    for _ in range(300000):
-        t, p = random.uniform(0, 1.2), random.uniform(0, 2 * math.pi)
-        f.write(f"{22 * math.sin(t) * math.cos(p)},{22 * math.sin(t) * math.sin(p)},{22 * math.cos(t)}\n")
-PY
+cap_points "$tmp/many.csv" 300000 2
 "$A" errors -i "$tmp/many.csv" --fits "$tmp/fits.json" -o "$tmp/killed" -q &
 pid=$!
 for _ in $(seq 1 3000); do [ -e "$tmp/killed/.errors-incomplete" ] && break; sleep 0.01; done
