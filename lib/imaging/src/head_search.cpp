@@ -1,0 +1,405 @@
+// Finding a joint head in a CT (see head_search.hpp).
+#include "head_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <itkSmoothingRecursiveGaussianImageFilter.h>
+
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+#include "articula/geometry/fibonacci.hpp"
+#include "articula/geometry/sphere_fit.hpp"
+#include "articula/imaging/edges.hpp"
+#include "itk_bridge.hpp"
+
+namespace articula::imaging::detail {
+
+std::string vec(const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "(" << v[0] << ", " << v[1] << ", " << v[2] << ")";
+  return s.str();
+}
+
+bool insideVolume(const ImageGeometry& g, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d idx = g.toIndex(x);
+  return (idx.array() >= -0.5).all() && (idx.array() <= g.size.cast<double>().array() - 0.5).all();
+}
+
+namespace {
+
+/// Mean of f x f x f blocks (f per axis): the CT on the search's coarse grid.
+Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
+  const ImageGeometry& g = volume.geometry;
+  Volume coarse;
+  coarse.geometry = g;
+  for (int a = 0; a < 3; ++a) coarse.geometry.size[a] = (g.size[a] + factor[a] - 1) / factor[a];
+  coarse.geometry.spacing = g.spacing.cwiseProduct(factor.cast<double>());
+  // Block (0,0,0) covers voxels 0..f-1: its centre is at index (f-1)/2.
+  coarse.geometry.origin = g.toPhysical((factor.cast<double>() - Eigen::Vector3d::Ones()) / 2.0);
+  std::vector<double> sum(static_cast<size_t>(coarse.geometry.voxelCount()), 0.0);
+  std::vector<int> count(sum.size(), 0);
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const auto n = static_cast<size_t>(coarse.geometry.linear(i / factor[0], j / factor[1], k / factor[2]));
+        sum[n] += volume.at(i, j, k);
+        ++count[n];
+      }
+  coarse.voxels.resize(sum.size());
+  for (size_t n = 0; n < sum.size(); ++n) coarse.voxels[n] = static_cast<float>(sum[n] / count[n]);
+  return coarse;
+}
+
+}  // namespace
+
+/// Casts kRayCount rays (Fibonacci lattice) from `start`, takes the first
+/// bone edge on each (imaging/edges.hpp: full resolution, sub-voxel), and
+/// fits a sphere to the edges within a band of the median distance, twice
+/// tightening the band; then once more from the fitted centre, so that the
+/// rays cross the head's surface nearly normally.
+/// Hand-written: ITK has no ray-cast edge detector; a sphere through edges
+/// that agree is the model a joint head's cap calls for.
+HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& start, const SegmentOptions& options) {
+  EdgeSearch search;
+  search.step_mm = 0.15;
+  search.min_inside_hu = options.hu_min;
+  const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
+  HeadCandidate c;
+  c.center = start;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<Eigen::Vector3d> edges(kRayCount, Eigen::Vector3d::Constant(NAN));
+    std::vector<double> distances;
+    for (int n = 0; n < kRayCount; ++n) {
+      const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
+      const Edge e = firstEdgeAlongRay(volume, c.center, u, 0.4 * r_lo, 1.25 * r_hi, search);
+      if (!e.found) continue;
+      edges[static_cast<size_t>(n)] = c.center + e.offset_mm * u;
+      distances.push_back(e.offset_mm);
+    }
+    if (distances.size() < 10) return c;
+    std::nth_element(distances.begin(), distances.begin() + static_cast<long>(distances.size() / 2), distances.end());
+    geometry::Sphere sphere{c.center, distances[distances.size() / 2]};
+    const double voxel = volume.geometry.spacing.maxCoeff();
+    std::vector<char> inlier(edges.size(), 0);
+    for (double band_share : {0.12, 0.06, 0.04}) {
+      const double band = std::max({band_share * sphere.radius, 0.75 * voxel, 1.0});
+      std::vector<Eigen::Vector3d> kept;
+      for (size_t n = 0; n < edges.size(); ++n) {
+        inlier[n] = !std::isnan(edges[n][0]) && std::abs((edges[n] - sphere.center).norm() - sphere.radius) <= band;
+        if (inlier[n]) kept.push_back(edges[n]);
+      }
+      if (kept.size() < 10) return c;
+      Eigen::MatrixX3d points(static_cast<Eigen::Index>(kept.size()), 3);
+      for (size_t i = 0; i < kept.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = kept[i].transpose();
+      try {
+        sphere = geometry::fitSphere(points);
+      } catch (const ProcessingError&) {
+        return c;  // degenerate support (a flat or tiny patch): no head here
+      }
+    }
+    c.center = sphere.center;
+    c.radius = sphere.radius;
+    double sse = 0;
+    int used = 0;
+    c.edge_mm.assign(edges.size(), NAN);
+    for (size_t n = 0; n < edges.size(); ++n) {
+      if (!inlier[n]) continue;
+      const double residual = (edges[n] - sphere.center).norm() - sphere.radius;
+      sse += residual * residual;
+      ++used;
+      // The edge's distance from the final centre along its ray's direction
+      // (the ray left from the previous centre, a fraction of a mm away).
+      c.edge_mm[n] = (edges[n] - sphere.center).dot(geometry::fibonacciDirection(static_cast<int>(n), kRayCount));
+    }
+    c.coverage = static_cast<double>(used) / kRayCount;
+    c.rms_mm = std::sqrt(sse / std::max(used, 1));
+  }
+  return c;
+}
+
+namespace {
+
+/// A bone-surface voxel of the search's coarse grid and its inward HU gradient.
+struct Voter {
+  Eigen::Vector3d x, n;
+};
+
+/// The Hough peak refined by a least-squares sphere through the surface
+/// voxels facing it at about its radius (the votes only locate it to a
+/// cell); coverage: the share of that sphere's surface that took part.
+HeadCandidate sphereOfFacingVoxels(const Eigen::Vector3d& peak, const std::vector<Voter>& voters,
+                                   const SegmentOptions& options, double cell_mm, double cell_area) {
+  const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
+  HeadCandidate c;
+  c.center = peak;
+  std::vector<double> distances;
+  for (const Voter& voter : voters) {
+    const Eigen::Vector3d d = peak - voter.x;
+    const double t = d.dot(voter.n);
+    if (t >= r_lo && t <= r_hi && (d - t * voter.n).norm() <= 1.5 * cell_mm) distances.push_back(t);
+  }
+  if (distances.empty()) return c;
+  std::nth_element(distances.begin(), distances.begin() + static_cast<long>(distances.size() / 2), distances.end());
+  c.radius = distances[distances.size() / 2];
+  size_t used = 0;
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    std::vector<Eigen::Vector3d> facing;  // surface voxels near the sphere, their normals towards its centre
+    for (const Voter& voter : voters) {
+      const Eigen::Vector3d d = c.center - voter.x;
+      const double t = d.norm();
+      if (std::abs(t - c.radius) <= 0.25 * c.radius && d.dot(voter.n) >= 0.9 * t) facing.push_back(voter.x);
+    }
+    used = facing.size();
+    if (used < 10) break;
+    Eigen::MatrixX3d points(static_cast<Eigen::Index>(used), 3);
+    for (size_t i = 0; i < used; ++i) points.row(static_cast<Eigen::Index>(i)) = facing[i].transpose();
+    try {
+      const geometry::Sphere sphere = geometry::fitSphere(points);
+      c.center = sphere.center;
+      c.radius = sphere.radius;
+    } catch (const ProcessingError&) {
+      break;  // degenerate support (a flat or tiny patch): keep the Hough estimate
+    }
+  }
+  c.coverage = static_cast<double>(used) * cell_area / (4 * M_PI * c.radius * c.radius);
+  return c;
+}
+
+/// Nearest direction of the ray lattice, through a table over polar and
+/// azimuth angles (a voxel's direction is looked up millions of times).
+class LatticeLookup {
+ public:
+  LatticeLookup() : nearest_(kPolarBins * kAzimuthBins) {
+    for (int a = 0; a < kPolarBins; ++a)
+      for (int b = 0; b < kAzimuthBins; ++b) {
+        const double polar = M_PI * (a + 0.5) / kPolarBins, azimuth = 2 * M_PI * (b + 0.5) / kAzimuthBins;
+        const Eigen::Vector3d u(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+        int best = 0;
+        for (int n = 1; n < kRayCount; ++n)
+          if (u.dot(geometry::fibonacciDirection(n, kRayCount)) > u.dot(geometry::fibonacciDirection(best, kRayCount))) best = n;
+        nearest_[static_cast<size_t>(a * kAzimuthBins + b)] = best;
+      }
+  }
+  int operator()(const Eigen::Vector3d& u) const {
+    const double polar = std::acos(std::clamp(u[2], -1.0, 1.0));
+    double azimuth = std::atan2(u[1], u[0]);
+    if (azimuth < 0) azimuth += 2 * M_PI;
+    const int a = std::min(kPolarBins - 1, static_cast<int>(polar / M_PI * kPolarBins));
+    const int b = std::min(kAzimuthBins - 1, static_cast<int>(azimuth / (2 * M_PI) * kAzimuthBins));
+    return nearest_[static_cast<size_t>(a * kAzimuthBins + b)];
+  }
+
+ private:
+  static constexpr int kPolarBins = 64, kAzimuthBins = 128;
+  std::vector<int> nearest_;
+};
+
+/// The head's edge distance per lattice direction, with the holes of its cap
+/// (a missed edge, the fovea's pit) filled from their neighbours: a
+/// direction without an edge whose nearest neighbours mostly have one lies
+/// inside the cap. The neck's directions, without neighbours on the cap, stay empty.
+std::vector<double> capEdges(const HeadCandidate& head) {
+  std::vector<double> edge = head.edge_mm;
+  constexpr int kNeighbours = 6;
+  std::vector<std::vector<int>> neighbours(kRayCount);
+  for (int n = 0; n < kRayCount; ++n) {
+    const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
+    std::vector<std::pair<double, int>> by_angle;
+    for (int m = 0; m < kRayCount; ++m)
+      if (m != n) by_angle.emplace_back(-u.dot(geometry::fibonacciDirection(m, kRayCount)), m);
+    std::partial_sort(by_angle.begin(), by_angle.begin() + kNeighbours, by_angle.end());
+    for (int k = 0; k < kNeighbours; ++k) neighbours[static_cast<size_t>(n)].push_back(by_angle[static_cast<size_t>(k)].second);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<double> next = edge;
+    for (int n = 0; n < kRayCount; ++n) {
+      if (!std::isnan(edge[static_cast<size_t>(n)])) continue;
+      double sum = 0;
+      int count = 0;
+      for (int m : neighbours[static_cast<size_t>(n)])
+        if (!std::isnan(edge[static_cast<size_t>(m)])) sum += edge[static_cast<size_t>(m)], ++count;
+      if (count >= 4) next[static_cast<size_t>(n)] = sum / count;
+    }
+    edge = next;
+  }
+  return edge;
+}
+
+}  // namespace
+
+/// Removes from the bone mask what lies beyond the head's edge in the
+/// directions of its cap: the joint gap and the socket, however narrow the
+/// gap and whatever the closing bridged. The margin keeps the partial-volume
+/// voxels of the head's own edge (the mesh stage places the surface on the
+/// CT's edge within them).
+void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head) {
+  static const LatticeLookup lookup;
+  const std::vector<double> edge = capEdges(head);
+  const ImageGeometry& g = mask.geometry;
+  const double margin = std::max(0.5, 0.5 * g.spacing.maxCoeff());
+  long long removed = 0;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        std::uint8_t& m = mask.at(i, j, k);
+        if (!m) continue;
+        const Eigen::Vector3d d = g.toPhysical(Eigen::Vector3d(i, j, k)) - head.center;
+        const double r = d.norm();
+        if (r < 0.7 * head.radius || r > 1.6 * head.radius) continue;
+        const double e = edge[static_cast<size_t>(lookup(d / r))];
+        if (!std::isnan(e) && r > e + margin) m = 0, ++removed;
+      }
+  log::debug("cut beyond the head's edges: " + std::to_string(removed) + " voxels");
+}
+
+namespace {
+
+/// The margin about the field of view's middle (left-right) that no head
+/// lies in: as given, or automatic (options.midline_margin_mm < 0).
+double effectiveMidlineMargin(const ImageGeometry& g, const SegmentOptions& options) {
+  if (options.midline_margin_mm >= 0) return options.midline_margin_mm;
+  double lo = INFINITY, hi = -INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
+    const double x = g.toPhysical(ijk)[0];
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return hi - lo >= kBothSidesWidthMm ? kAutomaticMidlineMargin : 0.0;
+}
+
+}  // namespace
+
+/// Automatic head search: a 3-D Hough transform for spheres on a grid of
+/// about options.search_spacing_mm. Every voxel on the bone's surface votes
+/// along its inward HU gradient at the distances a head radius can have: the
+/// normals of a spherical head meet in its centre, those of a shaft or a
+/// vertebral body only along a line, and a socket's point away from it. The
+/// strongest centres are refined by a least-squares sphere on the surface
+/// voxels facing them; the strongest on the requested side whose sphere is a
+/// plausible head is the head.
+/// Hand-written: ITK's Hough filters are 2-D only.
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head) {
+  const ImageGeometry& g = volume.geometry;
+  Eigen::Vector3i factor;
+  for (int a = 0; a < 3; ++a)
+    factor[a] = std::max(1, static_cast<int>(std::lround(options.search_spacing_mm / g.spacing[a])));
+  const Volume coarse = blockMean(volume, factor);
+  const ImageGeometry& cg = coarse.geometry;
+  // Smoothed once; the gradient is then taken only where it is needed (a
+  // gradient filter would fill three components at every voxel).
+  using FloatImage = itk::Image<float, 3>;
+  auto smoothing = itk::SmoothingRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
+  smoothing->SetInput(toItk(coarse));
+  smoothing->SetSigma(cg.spacing.maxCoeff());
+  smoothing->Update();
+  const Volume smooth = fromItk<float>(smoothing->GetOutput());
+
+  auto bone = [&](int i, int j, int k) {
+    const float hu = coarse.at(i, j, k);
+    return hu >= options.hu_min && hu <= options.hu_max;
+  };
+  std::vector<Voter> voters;
+  for (int k = 1; k + 1 < cg.size[2]; ++k)
+    for (int j = 1; j + 1 < cg.size[1]; ++j)
+      for (int i = 1; i + 1 < cg.size[0]; ++i) {
+        if (!bone(i, j, k)) continue;
+        if (bone(i - 1, j, k) && bone(i + 1, j, k) && bone(i, j - 1, k) && bone(i, j + 1, k) && bone(i, j, k - 1) &&
+            bone(i, j, k + 1))
+          continue;
+        const Eigen::Vector3d index_gradient(smooth.at(i + 1, j, k) - smooth.at(i - 1, j, k),
+                                             smooth.at(i, j + 1, k) - smooth.at(i, j - 1, k),
+                                             smooth.at(i, j, k + 1) - smooth.at(i, j, k - 1));
+        // Physical (LPS) gradient: d/dx = D^-T diag(1/spacing) d/dijk.
+        const Eigen::Vector3d n = cg.direction * index_gradient.cwiseQuotient(cg.spacing);
+        if (n.norm() <= 0) continue;
+        const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
+        if (options.roi_min && ((x.array() < options.roi_min->array()).any() || (x.array() > options.roi_max->array()).any()))
+          continue;
+        voters.push_back({x, n.normalized()});
+      }
+
+  // Votes along the inward normal, then summed over 3x3x3 cells: the
+  // discretised rays of one sphere spread over about one cell.
+  std::vector<float> votes(static_cast<size_t>(cg.voxelCount()), 0.0f);
+  const double step = 0.5 * cg.spacing.minCoeff();
+  const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
+  auto cellOf = [&](const Eigen::Vector3d& x, Eigen::Vector3i& v) {
+    v = cg.toIndex(x).array().round().cast<int>();
+    return (v.array() >= 0).all() && (v.array() < cg.size.array()).all();
+  };
+  for (const Voter& voter : voters)
+    for (double t = r_lo; t <= r_hi; t += step) {
+      Eigen::Vector3i v;
+      if (cellOf(voter.x + t * voter.n, v)) votes[static_cast<size_t>(cg.linear(v[0], v[1], v[2]))] += 1.0f;
+    }
+  const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
+  const double midline_margin = effectiveMidlineMargin(g, options);
+  struct Peak { Eigen::Vector3d x; double votes; };
+  std::vector<Peak> peaks;
+  for (int k = 1; k + 1 < cg.size[2]; ++k)
+    for (int j = 1; j + 1 < cg.size[1]; ++j)
+      for (int i = 1; i + 1 < cg.size[0]; ++i) {
+        double sum = 0;
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) sum += votes[static_cast<size_t>(cg.linear(i + di, j + dj, k + dk))];
+        const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
+        // LPS: +x points to the patient's left; the field of view is centred on the body.
+        if (sum > 0 && (options.side == Side::Right) == (x[0] < mid_x)) peaks.push_back({x, sum});
+      }
+  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.votes > b.votes; });
+  std::vector<Peak> kept;  // strongest first, at least a head radius apart
+  for (const Peak& p : peaks) {
+    bool separate = true;
+    for (const Peak& q : kept) separate = separate && (p.x - q.x).norm() > 0.5 * r_lo;
+    if (separate) kept.push_back(p);
+    if (kept.size() == 8) break;
+  }
+  // Each peak measured by rays cast from it at full resolution: the first
+  // bone edge on each ray, and a sphere through the edges that agree.
+  std::vector<HeadCandidate> candidates;
+  for (const Peak& p : kept) {
+    HeadCandidate c = measureHeadByRays(volume, p.x, options);
+    log::debug("head candidate " + vec(p.x) + " mm (" + std::to_string(p.votes) + " votes) -> centre " + vec(c.center) +
+               " mm, radius " + std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage) + ", RMS " +
+               std::to_string(c.rms_mm) + " mm");
+    candidates.push_back(std::move(c));
+  }
+  // The plausible head with the largest spherical bone surface: a trochanter
+  // or a tuberosity is smaller and less spherical, the outer surface of a
+  // socket is never the first edge seen from the centre.
+  const HeadCandidate* best = nullptr;
+  for (const HeadCandidate& c : candidates) {
+    const bool plausible = c.wellMeasured(g.spacing.maxCoeff()) && c.radius >= r_lo && c.radius <= r_hi &&
+                           c.coverage >= options.min_coverage && (c.center[0] < mid_x) == (options.side == Side::Right) &&
+                           std::abs(c.center[0] - mid_x) >= midline_margin && insideVolume(g, c.center);
+    if (plausible && (!best || c.area() > best->area())) best = &c;
+  }
+  if (best) {
+    head = *best;
+    return true;
+  }
+  // No candidate's edges make a sphere: coarse voxels (3 mm) blur the gap
+  // away and the rays meet socket and pelvis. Then the strongest peak whose
+  // sphere through the surface voxels facing it (at about its radius) is a
+  // plausible head; no cut along edges follows (edge_mm stays empty).
+  const double cell_area = cg.spacing.prod() / cg.spacing.minCoeff();
+  for (const Peak& p : kept) {
+    HeadCandidate c = sphereOfFacingVoxels(p.x, voters, options, cg.spacing.minCoeff(), cell_area);
+    log::debug("head candidate " + vec(p.x) + " mm by facing surface voxels: centre " + vec(c.center) + " mm, radius " +
+               std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage));
+    if (c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage &&
+        (c.center[0] < mid_x) == (options.side == Side::Right) && std::abs(c.center[0] - mid_x) >= midline_margin &&
+        insideVolume(g, c.center)) {
+      head = c;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace articula::imaging::detail

@@ -1,0 +1,54 @@
+#pragma once
+// Private to lib/imaging: finding a joint head in a CT (a Hough transform
+// for spheres proposes centres, rays cast from each measure the sphere
+// through the first bone edges seen from inside) and cutting the bone
+// beyond the head's edges. Used by segment.cpp.
+#include <string>
+#include <vector>
+
+#include "articula/imaging/image.hpp"
+#include "articula/imaging/segment.hpp"
+
+namespace articula::imaging::detail {
+
+// A joint head's cap is nearly spherical: the RMS of its edges about their
+// sphere stays below this share of the radius (real femoral and humeral
+// heads 1-2.5 %, superellipsoids of exponents up to 2.6 about 3 %) plus a
+// quarter voxel of quantisation; an ellipsoidal trochanter or a tuberosity
+// does not.
+constexpr double kMaxRelativeRms = 0.04;
+constexpr double kRmsVoxelShare = 0.25;
+// A field of view this wide (left-right) holds both sides of the body: a
+// joint head then lies at least kAutomaticMidlineMargin from its middle
+// (hips 70-110 mm, shoulders 120-200 mm; vertebral bodies, near-spherical
+// too, lie on it).
+constexpr double kBothSidesWidthMm = 250, kAutomaticMidlineMargin = 40;
+constexpr int kRayCount = 512;
+
+/// A head measured from a point inside it: the sphere through the first bone
+/// edges seen on rays from that point, and the edges themselves.
+struct HeadCandidate {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0, coverage = 0, rms_mm = 0;  // coverage: share of the rays whose edge lies on the sphere
+  std::vector<double> edge_mm;                  // per ray of the lattice, from `center`; NaN: no edge on the sphere
+  double area() const { return coverage * 4 * M_PI * radius * radius; }
+  /// Edges on a third of the rays and nearly spherical: a head's cap seen
+  /// through a visible gap.
+  bool wellMeasured(double voxel_mm) const {
+    return !edge_mm.empty() && coverage >= 0.3 && rms_mm <= kMaxRelativeRms * radius + kRmsVoxelShare * voxel_mm;
+  }
+};
+
+/// "(x, y, z)" with 4 significant digits, for messages.
+std::string vec(const Eigen::Vector3d& v);
+/// Whether x (LPS mm) lies within the grid (half a voxel beyond its centres).
+bool insideVolume(const ImageGeometry& g, const Eigen::Vector3d& x);
+
+/// Measures the head seen from `start` (a point inside it).
+HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& start, const SegmentOptions& options);
+/// The automatic search on options.side; false when no candidate is a plausible head.
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head);
+/// Clears the mask's voxels beyond the head's edges in the directions of its cap.
+void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head);
+
+}  // namespace articula::imaging::detail
