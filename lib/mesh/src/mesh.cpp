@@ -215,7 +215,7 @@ void EdgeSnapOptions::validate() const {
 
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary) {
-  constexpr double kMinShareOnEdge = 0.5;
+  constexpr double kMinShareOnEdge = 0.25;
   options.validate();
   const Eigen::Index n = mesh.vertices.rows();
   if (mesh.normals.rows() != n) throw ProcessingError("snapping to the CT's edges needs vertex normals");

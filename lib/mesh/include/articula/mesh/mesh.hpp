@@ -65,7 +65,7 @@ struct EdgeSnapSummary {
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours.
 /// Normals are recomputed. The CT's grid may differ from the label's. When
-/// fewer than half the vertices find an edge, nothing moves (summary tells).
+/// fewer than a quarter of the vertices find an edge, nothing moves (summary tells).
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary = nullptr);
 
