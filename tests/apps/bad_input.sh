@@ -40,6 +40,18 @@ grep -q 'unknown shape model' "$tmp/err" || fail "big name: $(head -c 300 "$tmp/
 if grep -q $'\x1b' "$tmp/err"; then fail "an escape sequence reached stderr raw"; fi
 grep -q '\\x1b' "$tmp/err" || fail "the escape is not shown escaped"
 
+# Fields a model does not have, and sizes beyond any body in millimetres: refused, not ignored.
+shape() {  # shape MODEL RADII EXPONENTS: a fits.json of one model
+  echo "{\"models\":[{\"model\":\"$1\",\"center_mm\":[0,0,0],\"radii_mm\":$2,\"rotation_deg\":[0,0,0],\"exponents\":$3,\"cx\":[1,0,0,0],\"cy\":[1,0,0,0]}]}"
+}
+shape ellipsoid "[22,22,21]" "[1.5,1.5,1.5]" > "$tmp/ellipsoid-exponents.json"
+expect_rc 3 "$A" errors -i "$tmp/head.csv" --fits "$tmp/ellipsoid-exponents.json" -o "$tmp/ee"
+grep -q "exponents \[1.5,1.5,1.5\] given for the model 'ellipsoid'" "$tmp/err" || fail "ellipsoid exponents: $(cat "$tmp/err")"
+shape ellipsoid "[1e300,1e300,1e300]" "[2,2,2]" > "$tmp/huge.json"
+expect_rc 3 "$A" errors -i "$tmp/head.csv" --fits "$tmp/huge.json" -o "$tmp/huge"
+grep -q "within 1e5 mm" "$tmp/err" || fail "radii 1e300: $(cat "$tmp/err")"
+[ ! -e "$tmp/huge/summary.json" ] || fail "errors wrote a summary for radii of 1e300"
+
 # errors -o over a folder holding one of its outputs from another run: refused before any file is written.
 "$A" fit -i "$tmp/head.csv" -o "$tmp/fits.json" -q
 mkdir -p "$tmp/mixed" && echo old > "$tmp/mixed/points_superovoid.ply"

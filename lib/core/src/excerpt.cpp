@@ -23,8 +23,13 @@ std::string excerpt(std::string_view text, std::size_t max_chars) {
 
 std::string describeJson(const nlohmann::json& value) {
   switch (value.type()) {
-    case nlohmann::json::value_t::array:
+    case nlohmann::json::value_t::array: {
+      // A short flat array (a vector of numbers) as it is; others by size.
+      bool flat = value.size() <= 8;
+      for (const auto& element : value) flat = flat && element.is_primitive() && !element.is_string();
+      if (flat) return excerpt(value.dump());
       return "an array of " + std::to_string(value.size()) + " element(s)";
+    }
     case nlohmann::json::value_t::object:
       return "an object of " + std::to_string(value.size()) + " key(s)";
     case nlohmann::json::value_t::string:

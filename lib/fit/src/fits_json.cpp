@@ -91,6 +91,26 @@ geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::
   p.exponents = vectorAt<3>(entry, "exponents", where);
   p.cx = vectorAt<4>(entry, "cx", where);
   p.cy = vectorAt<4>(entry, "cy", where);
+  // What a model does not use must hold its neutral value: an ellipsoid with
+  // exponents of 1.5 is not an ellipsoid, and silently dropping them would
+  // report another surface than the file describes.
+  const std::string model = entry.at("model").get<std::string>();
+  const bool exponents_used = p.model == ShapeModel::Superellipsoid || p.model == ShapeModel::Superovoid;
+  const bool coefficients_used = p.model == ShapeModel::Ovoid || p.model == ShapeModel::Superovoid;
+  if (!exponents_used && p.exponents != Eigen::Vector3d::Constant(2.0))
+    throw InputError(where + ": exponents " + describeJson(entry.at("exponents")) + " given for the model '" + model +
+                     "', which has none: expected [2, 2, 2]");
+  if (!coefficients_used && (p.cx != Eigen::Vector4d(1, 0, 0, 0) || p.cy != Eigen::Vector4d(1, 0, 0, 0)))
+    throw InputError(where + ": ovoid coefficients cx " + describeJson(entry.at("cx")) + " and cy " +
+                     describeJson(entry.at("cy")) + " given for the model '" + model + "', which has none: expected [1, 0, 0, 0]");
+  if (p.model == ShapeModel::Sphere && !(p.radii.maxCoeff() == p.radii.minCoeff()))
+    throw InputError(where + ": a sphere has three equal radii, found " + describeJson(entry.at("radii_mm")));
+  // Joint heads and bodies measured in millimetres: beyond these, distances
+  // lose their precision and the numbers reported would be noise.
+  constexpr double kMaxLengthMm = 1e5;
+  if (!(p.radii.maxCoeff() <= kMaxLengthMm) || !(p.center.cwiseAbs().maxCoeff() <= kMaxLengthMm))
+    throw InputError(where + ": expected radii and centre coordinates within 1e5 mm, found radii " +
+                     describeJson(entry.at("radii_mm")) + " and centre " + describeJson(entry.at("center_mm")));
   try {
     geometry::validate(p);
   } catch (const InvalidParameter& e) {
