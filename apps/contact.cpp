@@ -133,7 +133,7 @@ double timeNs(F&& f, int repeats = 5) {
   return best;
 }
 
-// One fitted model of a fits.json (issue 3 schema) as a contact shape, with an
+// One fitted model of a fits.json (docs/formats.md) as a contact shape, with an
 // extra rigid pose x' = R_pose x + t_pose applied on top of the fit.
 ConvexShape shapeFromFits(const std::filesystem::path& path, const std::string& model_name,
                           const Eigen::Matrix3d& R_pose, const Vector3d& t_pose) {

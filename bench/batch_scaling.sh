@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Batch scaling (issue 6): 8 phantom subjects, `articula batch -j 1` versus
+# Batch scaling: 8 phantom subjects, `articula batch -j 1` versus
 # `-j 2` (target: -j 2 <= 0.6x the time of -j 1), and a rerun of the finished
 # batch (target: <= 0.3x the first run). Prints the times and ratios.
 #   bash bench/batch_scaling.sh [build/bin] [scratch dir]

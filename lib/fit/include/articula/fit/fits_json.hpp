@@ -1,5 +1,5 @@
 #pragma once
-// The fits.json contract (issue 3): one entry of `models` per fitted model
+// The fits.json contract (docs/formats.md): one entry of `models` per fitted model
 // with "model", "center_mm", "radii_mm", "rotation_deg" [phi, theta, psi],
 // "rotation_matrix", "exponents", "cx", "cy", objective values and the
 // optimiser's report; plus top-level "best_model".
