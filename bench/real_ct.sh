@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The real-CT targets (issues 5 and 6) on ../shared/data/ct/thorax-shoulders-dicom
+# The real-CT targets on ../shared/data/ct/thorax-shoulders-dicom
 # (512 x 512 x 141), right humeral head, found automatically:
 #   segment + mesh + sample <= 20 s wall on 2 cores and <= 2 GB peak memory;
 #   `articula run` (segment -> ... -> report) <= 30 s wall.
