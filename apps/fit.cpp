@@ -1,6 +1,7 @@
 // `articula fit` / articula-fit: fits the hierarchy sphere -> ellipsoid ->
 // {superellipsoid, ovoid} -> superovoid to a point file and writes fits.json
 // (the contract read by errors and contact) and fits.csv beside it.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -43,10 +44,19 @@ std::map<std::string, std::pair<double, double>> readBounds(const std::filesyste
 }
 
 std::string fitsCsv(const fit::Summary& s) {
+  // Standard errors after the values, one per parameter of the superovoid
+  // (the widest model), in the values' units; empty where a model lacks the
+  // parameter or the points cannot identify it.
+  const auto all_names = geometry::parameterNames(ShapeModel::Superovoid);
+  const auto all_kinds = geometry::parameterKinds(ShapeModel::Superovoid);
   std::ostringstream out;
   out << "model,a_mm,b_mm,c_mm,gamma1,gamma2,gamma3,c0x,c1x,c2x,c3x,c0y,c1y,c2y,c3y,t1_mm,t2_mm,t3_mm,"
-         "phi_deg,theta_deg,psi_deg,rms_mm,sse_mm2,algebraic_objective,evaluations,seconds,converged\n"
-      << std::setprecision(12);
+         "phi_deg,theta_deg,psi_deg,rms_mm,sse_mm2,algebraic_objective,evaluations,seconds,converged";
+  for (size_t k = 0; k < all_names.size(); ++k) {
+    const std::string unit = all_kinds[k] == geometry::ParameterKind::Angle ? "deg" : geometry::parameterUnit(all_kinds[k]);
+    out << ',' << all_names[k] << "_se" << (unit.empty() ? "" : "_" + unit);
+  }
+  out << "\n" << std::setprecision(12);
   for (const auto& f : s.fits) {
     const auto& p = f.parameters;
     const Eigen::Vector3d r = p.model == ShapeModel::Sphere ? Eigen::Vector3d::Constant(p.radii[0]) : p.radii;
@@ -56,7 +66,16 @@ std::string fitsCsv(const fit::Summary& s) {
                      p.cx[3], p.cy[0], p.cy[1], p.cy[2], p.cy[3], p.center[0], p.center[1], p.center[2], deg[0],
                      deg[1], deg[2], f.rms_mm, f.sse_mm2, f.algebraic_objective})
       out << ',' << v;
-    out << ',' << f.evaluations << ',' << f.seconds << ',' << (f.converged ? "true" : "false") << "\n";
+    out << ',' << f.evaluations << ',' << f.seconds << ',' << (f.converged ? "true" : "false");
+    const auto names = geometry::parameterNames(p.model);
+    for (size_t k = 0; k < all_names.size(); ++k) {
+      out << ',';
+      const auto at = std::find(names.begin(), names.end(), all_names[k]);
+      if (at == names.end() || f.uncertainty.standard_error.size() != static_cast<Eigen::Index>(names.size())) continue;
+      const double se = f.uncertainty.standard_error[at - names.begin()];
+      if (std::isfinite(se)) out << (all_kinds[k] == geometry::ParameterKind::Angle ? se * 180.0 / M_PI : se);
+    }
+    out << "\n";
   }
   return out.str();
 }

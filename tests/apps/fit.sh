@@ -19,6 +19,8 @@ for key in '"best_model"' '"coordinate_system": "LPS"' '"center_mm"' '"radii_mm"
   grep -q "$key" "$tmp/fits.json" || fail "fits.json has $key"
 done
 grep -q '"best_model": "superovoid"' "$tmp/fits.json" || fail "best model is the true superovoid"
+se_a=$(csv_value "$tmp/fits.csv" sphere a_se_mm)
+python3 -c "import sys; se = float(sys.argv[1]); assert 0 < se < 0.5, se" "$se_a" || fail "the sphere's radius has no plausible standard error in fits.csv: '$se_a'"
 rms_so=$(csv_value "$tmp/fits.csv" superovoid rms_mm)
 awk -v r="$rms_so" 'BEGIN{exit !(r < 1e-4)}' || fail "superovoid rms $rms_so >= 1e-4 mm on exact points"
 c_so=$(csv_value "$tmp/fits.csv" superovoid c_mm)
