@@ -7,6 +7,7 @@
 
 #include "articula/cli/command.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/pipeline/batch.hpp"
@@ -51,20 +52,28 @@ class BatchCommand : public cli::Command {
         log::warn(manifest_.string() + ":" + std::to_string(s.line) + ": subject " + s.id + ": " + p);
         ++problems;
       }
+    pipeline::BatchOptions options;
+    options.study_dir = study_dir_;
+    options.seed = common.seed;
+    if (!subject_config_.empty()) options.extra_args = {"--config", fs::absolute(subject_config_).string()};
+    // Every subject's command line must parse before any subject runs: a bad
+    // option column would otherwise fail each of them in turn.
+    for (const auto& s : subjects) {
+      const std::string problem = cli::argumentProblem("run", pipeline::runArguments(s, options));
+      if (!problem.empty())
+        throw InputError(manifest_.string() + ":" + std::to_string(s.line) + ": subject " + s.id +
+                         ": its options do not parse as 'articula run' options: " + excerpt(problem, 200));
+    }
     if (validate_only_) {
       if (common.json) cli::printJson({{"subjects", subjects.size()}, {"problems", problems}});
       if (problems) throw InputError(std::to_string(problems) + " subject input problem(s) in " + manifest_.string());
       log::info("manifest ok: " + std::to_string(subjects.size()) + " subjects");
       return 0;
     }
-    pipeline::BatchOptions options;
-    options.study_dir = study_dir_;
     options.executable = selfExecutable();
     options.jobs = jobs_;
-    options.seed = common.seed;
     options.quiet = common.verbosity == 0;
     options.rerun_finished = common.force;
-    if (!subject_config_.empty()) options.extra_args = {"--config", fs::absolute(subject_config_).string()};
     if (gather_only_) options.jobs = 1;
     fs::create_directories(study_dir_);
     pipeline::BatchSummary summary;

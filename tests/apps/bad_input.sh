@@ -128,4 +128,37 @@ grep -q "max-radius (mm): expected 1 to 60" "$tmp/err" || fail "max-radius: $(ca
 expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --close-radius 1000
 expect_rc 2 "$A" nosuch --help
 grep -q "unknown command 'nosuch'" "$tmp/err" || fail "nosuch --help: $(cat "$tmp/err")"
+# Manifest columns the batch sets itself, or that no stage has: refused by
+# --validate and by the batch before any subject runs.
+printf 'subject,input,joint,side,until\ns1,4d.nii,hip,left,sample\n' > "$tmp/until.csv"
+expect_rc 3 "$A" batch "$tmp/until.csv" -o "$tmp/study-until"
+grep -q "column 'until': --until is set by the batch" "$tmp/err" || fail "until column: $(cat "$tmp/err")"
+[ ! -e "$tmp/study-until" ] || fail "batch made a study folder for a bad manifest"
+printf 'subject,input,joint,side,output\ns1,4d.nii,hip,left,elsewhere\n' > "$tmp/output.csv"
+expect_rc 3 "$A" batch "$tmp/output.csv" -o "$tmp/study-output" --validate
+grep -q "column 'output'" "$tmp/err" || fail "output column: $(cat "$tmp/err")"
+printf 'subject,input,joint,side,smoothnes\ns1,4d.nii,hip,left,0.5\n' > "$tmp/typo.csv"
+expect_rc 3 "$A" batch "$tmp/typo.csv" -o "$tmp/study-typo" --validate
+grep -q "typo.csv:2: subject s1: its options do not parse.*smoothnes" "$tmp/err" || fail "unknown column: $(cat "$tmp/err")"
+printf '\xef\xbb\xbfid,input,joint,side\ns1,4d.nii,hip,left\n' > "$tmp/bom.csv"
+expect_rc 3 "$A" batch "$tmp/bom.csv" -o "$tmp/study-bom" --validate
+grep -q "found 'id,input,joint,side'" "$tmp/err" || fail "BOM shown in the message: $(cat "$tmp/err")"
+printf 'subject,input,joint,side\n..,4d.nii,hip,left\n' > "$tmp/dots.csv"
+expect_rc 3 "$A" batch "$tmp/dots.csv" -o "$tmp/study-dots" --validate
+grep -q "not starting with '.'" "$tmp/err" || fail "subject '..': $(cat "$tmp/err")"
+
+# A NIfTI cut short (half its voxels), plain and re-gzipped: refused, not zero-filled.
+nifti "$tmp/whole.nii" 16,16,16 1,1,1
+head -c 4500 "$tmp/whole.nii" > "$tmp/half.nii"
+gzip -kf "$tmp/half.nii"
+for f in half.nii half.nii.gz; do
+  expect_rc 3 "$A" segment -i "$tmp/$f" -o "$tmp/half-label.nii.gz"
+  grep -q "truncated: expected 8544 bytes of header and voxels (4096 voxels of 16 bits), found 4500" "$tmp/err" ||
+    fail "truncated $f: $(cat "$tmp/err")"
+done
+gzip -c "$tmp/whole.nii" > "$tmp/whole.nii.gz"
+head -c $(( $(wc -c < "$tmp/whole.nii.gz") - 12 )) "$tmp/whole.nii.gz" > "$tmp/cut.nii.gz"  # no gzip trailer
+expect_rc 3 "$A" segment -i "$tmp/cut.nii.gz" -o "$tmp/half-label.nii.gz"
+grep -Eq "damaged|truncated|expected a NIfTI header" "$tmp/err" || fail "a cut gzip stream: $(cat "$tmp/err")"
+[ ! -e "$tmp/half-label.nii.gz" ] || fail "a label was written for a truncated image"
 echo "bad input: ok"

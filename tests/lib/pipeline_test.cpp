@@ -159,8 +159,29 @@ TEST(Manifest, ResolvesPathsAndOptions) {
   rejects("subject,input,joint,side\na,x,knee,left\n", "bad.csv:2: joint");
   rejects("subject,input,joint,side\na,x,hip,up\n", "side");
   rejects("subject,input,joint,side\na,x,hip,left\na,y,hip,left\n", "bad.csv:3: subject id 'a' appears twice");
-  rejects("subject,input,joint,side\n../a,x,hip,left\n", "expected letters");
+  rejects("subject,input,joint,side\n../a,x,hip,left\n", "expected a folder name");
+  rejects("subject,input,joint,side\n..,x,hip,left\n", "not starting with '.'");
+  rejects("subject,input,joint,side,until\na,x,hip,left,sample\n", "--until is set by the batch");
+  rejects("subject,input,joint,side,output\na,x,hip,left,o\n", "--output is set by the batch");
+  rejects("subject,input,joint,side,Seed Point\na,x,hip,left,1\n", "expected an option name");
+  rejects("subject,input,joint,side,ratio,ratio\na,x,hip,left,1,2\n", "column 'ratio' appears twice");
+  rejects("subject,input,joint,side,x\n\x1b[31m,x,hip,left,1\n", "\\x1b[31m");
   rejects("subject,input,joint,side\n", "at least one subject");
+}
+
+TEST(Manifest, SpreadsheetByteOrderMarkIsNoPartOfTheHeader) {
+  const fs::path dir = scratch("manifest_bom");
+  write(dir / "m.csv", "\xEF\xBB\xBFsubject,input,joint,side\ns1,a.nii,hip,left\n");
+  const auto subjects = p::readManifest(dir / "m.csv");
+  ASSERT_EQ(subjects.size(), 1u);
+  EXPECT_EQ(subjects[0].id, "s1");
+  write(dir / "m.csv", "\xEF\xBB\xBFid,input,joint,side\ns1,a.nii,hip,left\n");
+  try {
+    p::readManifest(dir / "m.csv");
+    ADD_FAILURE() << "accepted a header without subject";
+  } catch (const articula::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("found 'id,input,joint,side'"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Markups, SlicerSchemaInLps) {

@@ -168,6 +168,22 @@ int runCommandInProcess(const std::string& name, const std::vector<std::string>&
   return rc;
 }
 
+std::string argumentProblem(const std::string& name, const std::vector<std::string>& args) {
+  auto command = createCommand(name);
+  CLI::App app;
+  app.name("articula " + name);
+  CommonOptions common;
+  addCommonOptions(app, common);
+  command->declare(app);
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    return e.get_exit_code() == 0 ? "asks for help or the version and would run nothing" : e.what();
+  }
+  return "";
+}
+
 void printJson(const nlohmann::json& summary) { std::cout << summary.dump(2) << std::endl; }
 
 }  // namespace articula::cli

@@ -22,6 +22,7 @@
 #include <itkMetaDataObject.h>
 
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 #include "articula/core/log.hpp"
 #include "itk_bridge.hpp"
 
@@ -54,7 +55,7 @@ std::vector<double> parseNumbers(const std::string& text) {
 
 }  // namespace
 
-void checkNiftiSpacing(const fs::path& path) {
+void checkNiftiFile(const fs::path& path) {
   const std::string name = path.filename().string();
   const auto ends = [&name](const std::string& ext) {
     return name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
@@ -66,38 +67,76 @@ void checkNiftiSpacing(const fs::path& path) {
   if (!file) throw InputError("cannot open '" + path.string() + "': " + std::strerror(errno));
   unsigned char header[540] = {};
   const int got = gzread(file, header, sizeof header);
-  gzclose(file);
-  if (got < 348) throw InputError(path.string() + ": expected a NIfTI header of 348 bytes, found " + std::to_string(std::max(got, 0)));
-  const auto int32 = [&header](int at, bool swap) {
-    std::uint32_t v;
-    std::memcpy(&v, header + at, 4);
-    return static_cast<std::int32_t>(swap ? __builtin_bswap32(v) : v);
+  if (got < 348) {
+    gzclose(file);
+    throw InputError(path.string() + ": expected a NIfTI header of 348 bytes, found " + std::to_string(std::max(got, 0)));
+  }
+  const auto bytes = [&header](int at, int n, bool swap) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < n; ++i) v |= std::uint64_t(header[at + (swap ? i : n - 1 - i)]) << (8 * (n - 1 - i));
+    return v;  // little-endian read unless swapped
   };
   for (bool swap : {false, true}) {
-    const std::int32_t size = int32(0, swap);
+    const auto size = static_cast<std::int32_t>(bytes(0, 4, swap));
     if (size != 348 && !(size == 540 && got >= 540)) continue;
-    for (int axis = 1; axis <= 3; ++axis) {
-      double spacing;
-      if (size == 348) {
-        std::uint32_t bits;
-        std::memcpy(&bits, header + 76 + 4 * axis, 4);
-        if (swap) bits = __builtin_bswap32(bits);
+    const bool v1 = size == 348;
+    const auto real = [&](int at) {
+      if (v1) {
+        const auto bits = static_cast<std::uint32_t>(bytes(at, 4, swap));
         float f;
         std::memcpy(&f, &bits, 4);
-        spacing = f;
-      } else {
-        std::uint64_t bits;
-        std::memcpy(&bits, header + 104 + 8 * axis, 8);
-        if (swap) bits = __builtin_bswap64(bits);
-        std::memcpy(&spacing, &bits, 8);
+        return double(f);
       }
-      if (!(std::isfinite(spacing) && spacing != 0))
+      const std::uint64_t bits = bytes(at, 8, swap);
+      double d;
+      std::memcpy(&d, &bits, 8);
+      return d;
+    };
+    const auto dim = [&](int i) {
+      return v1 ? double(static_cast<std::int16_t>(bytes(40 + 2 * i, 2, swap)))
+                : double(static_cast<std::int64_t>(bytes(16 + 8 * i, 8, swap)));
+    };
+    for (int axis = 1; axis <= 3; ++axis) {
+      const double spacing = real((v1 ? 76 : 104) + (v1 ? 4 : 8) * axis);
+      if (!(std::isfinite(spacing) && spacing != 0)) {
+        gzclose(file);
         throw InputError(path.string() + ": the NIfTI header's pixdim[" + std::to_string(axis) +
                          "] (voxel size along axis " + std::to_string(axis) + ") is " + std::to_string(spacing) +
                          "; expected a non-zero, finite size in mm");
+      }
     }
+    // A single-file NIfTI must hold all its voxels: ITK reads a truncated file
+    // (or a truncated gzip stream) without complaint and fills the rest with
+    // zeros, so the stream is measured here, at the cost of one more decompression.
+    const bool single_file = std::memcmp(header + (v1 ? 344 : 4), v1 ? "n+1" : "n+2", 3) == 0;
+    const double rank = dim(0);
+    const double bitpix = double(static_cast<std::int16_t>(bytes(v1 ? 72 : 14, 2, swap)));
+    const double offset = v1 ? real(108) : double(static_cast<std::int64_t>(bytes(168, 8, swap)));
+    if (single_file && rank >= 1 && rank <= 7 && bitpix > 0 && offset >= size) {
+      double voxels = 1;
+      for (int i = 1; i <= rank; ++i) voxels *= std::max(dim(i), 1.0);
+      const double expected = offset + voxels * bitpix / 8;
+      double found = got;
+      std::vector<unsigned char> chunk(1 << 20);
+      for (int n; found < expected && (n = gzread(file, chunk.data(), static_cast<unsigned>(chunk.size()))) > 0;)
+        found += n;
+      int zerr = Z_OK;
+      const char* zmessage = gzerror(file, &zerr);
+      gzclose(file);
+      if (zerr != Z_OK && zerr != Z_STREAM_END)
+        throw InputError(path.string() + ": the compressed data is damaged after " + std::to_string(std::llround(found)) +
+                         " bytes (" + excerpt(zmessage ? zmessage : "zlib error") + "); expected " +
+                         std::to_string(std::llround(expected)) + " bytes of header and voxels");
+      if (found < expected)
+        throw InputError(path.string() + ": truncated: expected " + std::to_string(std::llround(expected)) +
+                         " bytes of header and voxels (" + std::to_string(std::llround(voxels)) + " voxels of " +
+                         std::to_string(int(bitpix)) + " bits), found " + std::to_string(std::llround(found)));
+      return;
+    }
+    gzclose(file);
     return;
   }
+  gzclose(file);
   throw InputError(path.string() + ": not a NIfTI file (its header size is neither 348 nor 540 in either byte order)");
 }
 

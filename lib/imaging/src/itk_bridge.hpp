@@ -71,12 +71,14 @@ Image<T> fromItk(const itk::Image<U, 3>* image) {
 
 /// Throws InputError when a NIfTI file's own header (not ITK's reading of
 /// it, which puts 1 mm in place of a pixdim of 0 or NaN) gives a spatial
-/// voxel size that is not a positive finite number. Other formats: no-op.
-void checkNiftiSpacing(const std::filesystem::path& path);
+/// voxel size that is not a positive finite number, or when a single-file
+/// NIfTI holds fewer bytes than its header promises (ITK zero-fills them).
+/// Other formats: no-op.
+void checkNiftiFile(const std::filesystem::path& path);
 
 template <typename T>
 Image<T> readImageFile(const std::filesystem::path& path) {
-  checkNiftiSpacing(path);
+  checkNiftiFile(path);
   // What the file holds, before ITK reads it as 3-D (it would silently take
   // the first volume of a 4-D image and the first component of a vector).
   if (auto io = itk::ImageIOFactory::CreateImageIO(path.string().c_str(), itk::CommonEnums::IOFileMode::ReadMode)) {

@@ -75,6 +75,15 @@ bool finishedEarlier(const fs::path& dir) {
 
 }  // namespace
 
+std::vector<std::string> runArguments(const Subject& s, const BatchOptions& options) {
+  std::vector<std::string> args = {"-i",     s.input.string(), "-o",     subjectDir(options.study_dir, s.id).string(),
+                                   "--joint", s.joint,         "--side", s.side,
+                                   "--seed",  std::to_string(options.seed), "--threads", "1"};
+  args.insert(args.end(), s.options.begin(), s.options.end());
+  args.insert(args.end(), options.extra_args.begin(), options.extra_args.end());
+  return args;
+}
+
 BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& options) {
   if (options.jobs < 1) throw UsageError("-j: expected at least 1 job, found " + std::to_string(options.jobs));
   const auto batch_start = std::chrono::steady_clock::now();
@@ -95,11 +104,8 @@ BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& 
         continue;
       }
       fs::create_directories(dir);
-      std::vector<std::string> args = {options.executable.string(), "run", "-i", s.input.string(), "-o",
-                                       dir.string(), "--joint", s.joint, "--side", s.side,
-                                       "--seed", std::to_string(options.seed), "--threads", "1"};
-      args.insert(args.end(), s.options.begin(), s.options.end());
-      args.insert(args.end(), options.extra_args.begin(), options.extra_args.end());
+      std::vector<std::string> args = {options.executable.string(), "run"};
+      for (auto& a : runArguments(s, options)) args.push_back(std::move(a));
       const auto start = std::chrono::steady_clock::now();
       try {
         out.exit_code = runProcess(args, dir / "run.log");

@@ -73,6 +73,8 @@ CsvTable readCsv(const std::filesystem::path& path) {
   bool have_header = false;
   while (std::getline(in, line)) {
     ++line_number;
+    // Spreadsheets save CSV with a UTF-8 byte-order mark; it is no part of the first field.
+    if (line_number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const std::string t = trim(line);
     if (t.empty() || t[0] == '#') continue;
     const int record_line = line_number;

@@ -3,11 +3,35 @@
 #include <set>
 
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 #include "articula/pipeline/csv.hpp"
 
 namespace articula::pipeline {
 
 namespace fs = std::filesystem;
+
+namespace {
+// Options the batch sets for every subject itself (where its outputs go, which
+// stages run, how it is seeded and reported); a column may not override them.
+const std::set<std::string> kBatchOwnedOptions = {"input", "output", "joint",  "side",  "seed",   "threads", "from",
+                                                  "until", "force",  "json",   "quiet", "verbose", "config", "help",
+                                                  "version", "i",    "o",      "q",     "v"};
+
+// A column name becomes `--name` on the subject's command line.
+void checkOptionColumn(const std::string& column, const fs::path& manifest) {
+  const std::string where = manifest.string() + ":1: column '" + excerpt(column) + "': ";
+  if (column.empty() || column.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos ||
+      column[0] == '-' || column[0] == '_')
+    throw InputError(where + "expected an option name of lower-case letters, digits, '_' or '-' (e.g. seed_point)");
+  std::string option = column;
+  for (char& ch : option)
+    if (ch == '_') ch = '-';
+  if (kBatchOwnedOptions.count(option))
+    throw InputError(where + "--" + option +
+                     " is set by the batch for every subject (outputs go to STUDYDIR/<subject>, every stage runs); "
+                     "a manifest column may set a stage option only");
+}
+}  // namespace
 
 std::vector<Subject> readManifest(const fs::path& manifest) {
   const CsvTable table = readCsv(manifest);
@@ -15,7 +39,13 @@ std::vector<Subject> readManifest(const fs::path& manifest) {
   for (size_t i = 0; i < 4; ++i)
     if (table.header.size() <= i || table.header[i] != required[i])
       throw InputError(manifest.string() + ":1: expected the header to start with subject,input,joint,side, found '" +
-                       csvLine(table.header) + "'");
+                       excerpt(csvLine(table.header), 120) + "'");
+  std::set<std::string> columns;
+  for (size_t c = 4; c < table.header.size(); ++c) {
+    checkOptionColumn(table.header[c], manifest);
+    if (!columns.insert(table.header[c]).second)
+      throw InputError(manifest.string() + ":1: column '" + table.header[c] + "' appears twice");
+  }
   const fs::path base = fs::absolute(manifest).parent_path();
   std::vector<Subject> subjects;
   std::set<std::string> seen;
@@ -27,17 +57,19 @@ std::vector<Subject> readManifest(const fs::path& manifest) {
     s.line = table.row_lines[r];
     if (s.id.empty()) throw InputError(where + "expected a subject id, found an empty field");
     if (s.id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") != std::string::npos ||
-        s.id[0] == '.')
-      throw InputError(where + "subject id '" + s.id + "': expected letters, digits, '.', '_' or '-' only");
+        s.id[0] == '.' || s.id.size() > 128)
+      throw InputError(where + "subject id '" + excerpt(s.id) +
+                       "': expected a folder name of letters, digits, '.', '_' or '-', not starting with '.' "
+                       "(no '.', '..' or hidden folders), at most 128 characters");
     if (!seen.insert(s.id).second) throw InputError(where + "subject id '" + s.id + "' appears twice");
     if (row[1].empty()) throw InputError(where + "expected an input path for subject '" + s.id + "'");
     s.input = fs::path(row[1]).is_absolute() ? fs::path(row[1]) : (base / row[1]).lexically_normal();
     s.joint = row[2].empty() ? "hip" : row[2];
     s.side = row[3].empty() ? "right" : row[3];
     if (s.joint != "hip" && s.joint != "shoulder")
-      throw InputError(where + "joint: expected hip or shoulder, found '" + s.joint + "'");
+      throw InputError(where + "joint: expected hip or shoulder, found '" + excerpt(s.joint) + "'");
     if (s.side != "left" && s.side != "right")
-      throw InputError(where + "side: expected left or right, found '" + s.side + "'");
+      throw InputError(where + "side: expected left or right, found '" + excerpt(s.side) + "'");
     for (size_t c = 4; c < table.header.size(); ++c) {
       if (row[c].empty()) continue;
       std::string option = "--" + table.header[c];

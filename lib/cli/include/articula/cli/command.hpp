@@ -68,6 +68,11 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
 /// by the command records `articula <name> args...` as its command line.
 int runCommandInProcess(const std::string& name, const std::vector<std::string>& args);
 
+/// Parses `args` as `articula <name> args...` would, without running the
+/// command: the parser's complaint (an unknown option, a value of the wrong
+/// type or out of its declared range), or an empty string when they parse.
+std::string argumentProblem(const std::string& name, const std::vector<std::string>& args);
+
 /// Prints a JSON summary on stdout (for --json).
 void printJson(const nlohmann::json& summary);
 

@@ -10,8 +10,12 @@
 namespace articula::imaging {
 
 /// One DICOM series found in a folder.
+/// How a series whose Series Instance UID is empty is named in listings and
+/// chosen with --series-uid (a real UID holds digits and dots only).
+inline constexpr const char* kEmptySeriesUid = "empty";
+
 struct SeriesInfo {
-  std::string uid;          // GDCM series identifier (Series Instance UID, possibly with details)
+  std::string uid;          // Series Instance UID; kEmptySeriesUid for files whose UID is empty
   std::string modality;     // (0008,0060)
   std::string description;  // (0008,103E)
   int files = 0;
@@ -29,6 +33,7 @@ struct ReadReport {
   std::string series_uid;
   std::string modality;
   std::vector<SeriesInfo> series;  // every series of the folder
+  std::vector<std::string> unreadable_files;  // files of the folder that are no readable DICOM
   double slice_spacing_mm = 0;     // measured from Image Position Patient
   double slice_spacing_spread_mm = 0;
   double gantry_tilt_deg = 0;

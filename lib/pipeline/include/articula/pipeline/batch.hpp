@@ -39,6 +39,10 @@ struct BatchSummary {
 /// The folder of one subject's outputs.
 std::filesystem::path subjectDir(const std::filesystem::path& study_dir, const std::string& id);
 
+/// The arguments of a subject's `articula run` (without the program and the
+/// command name).
+std::vector<std::string> runArguments(const Subject& subject, const BatchOptions& options);
+
 /// Runs every subject; never throws for a failing subject.
 BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& options);
 
