@@ -32,7 +32,7 @@ class MeshCommand : public cli::Command {
     app.add_option("--ct", ct_,
                    "The CT the label came from (DICOM folder or image file): vertices move along their normals onto "
                    "its bone edge (sub-voxel; without it the surface is the label's smoothed voxel boundary)");
-    app.add_option("--series-uid", series_uid_, "With --ct: the DICOM series to read when the folder holds several");
+    app.add_option("--series-uid", series_uid_, "With --ct: the DICOM series to read when the folder holds several (empty: the series whose UID is empty)");
     app.add_option("--edge-search", snap_.search_mm,
                    "With --ct: edge search either side of a vertex, mm (0: 1.5 voxels, at least 1.5 mm)")
         ->check(CLI::Range(0.0, 10.0))

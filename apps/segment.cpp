@@ -32,7 +32,7 @@ class SegmentCommand : public cli::Command {
     app.add_option("--side", side_, "Patient side: right or left")->check(CLI::IsMember({"right", "left"}))->capture_default_str();
     app.add_option("--seed-point", seed_point_, "A point inside the head, X,Y,Z in LPS mm (skips the search)")
         ->delimiter(',')->expected(3);
-    app.add_option("--series-uid", series_uid_, "DICOM series to read when the folder holds several");
+    app.add_option("--series-uid", series_uid_, "DICOM series to read when the folder holds several (empty: the series whose Series Instance UID is empty)");
     app.add_option("--hu-min", options_.hu_min, "Lower end of the bone window (HU)")->capture_default_str();
     app.add_option("--hu-max", options_.hu_max, "Upper end of the bone window (HU)")->capture_default_str();
     app.add_option("--surface-hu", options_.surface_hu, "Level of the head's final surface (HU)")->capture_default_str();

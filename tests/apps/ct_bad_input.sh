@@ -26,10 +26,37 @@ test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for bad input"; fai
 cp -r "$T/p/dicom" "$T/gap"
 rm "$T/gap/slice_0020.dcm"
 expect 3 "non-uniform slice spacing" -- "$B/articula-segment" -i "$T/gap" -o "$T/l.nii.gz"
+# One slice cut short: inside its meta header (GDCM aborted the process),
+# inside its pixel data (read zero-filled, exit 0), or before its preamble
+# (skipped by GDCM): each refused, naming the file.
+for cut in 300 5000; do
+  rm -rf "$T/cut" && cp -r "$T/p/dicom" "$T/cut"
+  head -c $cut "$T/p/dicom/slice_0020.dcm" > "$T/cut/slice_0020.dcm"
+  expect 3 "^  slice_0020.dcm: element (0002\|^  slice_0020.dcm: element (7FE0,0010)" -- "$B/articula-segment" -i "$T/cut" -o "$T/l.nii.gz"
+done
+head -c 100 "$T/p/dicom/slice_0020.dcm" > "$T/cut/slice_0020.dcm"
+expect 3 "missing slice?); the folder holds 1 file(s) that could not be read as DICOM: slice_0020.dcm" -- \
+  "$B/articula-segment" -i "$T/cut" -o "$T/l.nii.gz"
+test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for a damaged series"; fail=1; }
 # Two CT series in one folder: listed, --series-uid needed.
 "$B/articula" phantom -o "$T/q" --seed 3 --spacing 1.5,1.5,2 -q
 mkdir -p "$T/two" && cp "$T/p/dicom/"*.dcm "$T/two/" && for f in "$T/q/dicom/"*.dcm; do cp "$f" "$T/two/q_$(basename "$f")"; done
 expect 3 "several CT series" -- "$B/articula-segment" -i "$T/two" -o "$T/l.nii.gz"
+# A series whose Series Instance UID is empty: listed as 'empty' and chosen by that name.
+mkdir -p "$T/blank" && cp "$T/p/dicom/"*.dcm "$T/blank/"
+python3 - "$T/q/dicom" "$T/blank" <<'PY'
+import glob, os, struct, sys
+for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.dcm"))):
+    b = bytearray(open(f, "rb").read())
+    i = b.find(b"\x20\x00\x0e\x00", 132)  # (0020,000E), implicit VR: a 4-byte length follows
+    n = struct.unpack_from("<I", b, i + 4)[0]
+    b[i + 8:i + 8 + n] = bytes(n)
+    open(os.path.join(sys.argv[2], "q_" + os.path.basename(f)), "wb").write(b)
+PY
+expect 3 "  empty  modality CT, 64 files, 'articula phantom seed 3'" -- "$B/articula-segment" -i "$T/blank" -o "$T/l.nii.gz"
+"$B/articula-segment" -i "$T/blank" -o "$T/blank.nii.gz" --series-uid empty --json -q > "$T/blank.json" ||
+  { echo "FAIL: --series-uid empty"; fail=1; }
+grep -q '"series_used": "empty"' "$T/blank.json" || { echo "FAIL: series_used: $(cat "$T/blank.json")"; fail=1; }
 # An HU window with no voxel.
 expect 3 "no voxel in the HU window" -- "$B/articula-segment" -i "$T/p/phantom.nii.gz" -o "$T/l.nii.gz" --hu-min 5000 --hu-max 6000
 # No head on the left of a right hip phantom (with a radius range that excludes the trochanter).

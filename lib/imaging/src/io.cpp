@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <set>
 #include <sstream>
 #include <unistd.h>
 
@@ -24,6 +25,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
 #include "articula/core/log.hpp"
+#include "dicom_check.hpp"
 #include "itk_bridge.hpp"
 
 namespace articula::imaging {
@@ -167,6 +169,13 @@ bool isImageFile(const fs::path& p) {
   return false;
 }
 
+std::string unreadableList(const ReadReport& report) {
+  std::string list;
+  for (size_t i = 0; i < report.unreadable_files.size() && i < 5; ++i)
+    list += (i ? ", " : "") + excerpt(report.unreadable_files[i]);
+  return list + (report.unreadable_files.size() > 5 ? ", ..." : "");
+}
+
 /// Measures slice gaps and gantry tilt from Image Position/Orientation Patient
 /// of every slice, refusing gaps or tilt that ITK would silently mis-place.
 void checkSlices(const std::vector<std::string>& files, const itk::ImageSeriesReader<itk::Image<float, 3>>& reader,
@@ -198,6 +207,9 @@ void checkSlices(const std::vector<std::string>& files, const itk::ImageSeriesRe
       m << "DICOM series: non-uniform slice spacing: expected " << std::fabs(median) << " mm between slices, found "
         << std::fabs(gaps[k]) << " mm between " << fs::path(files[k]).filename().string() << " and "
         << fs::path(files[k + 1]).filename().string() << (std::fabs(gaps[k]) > 1.5 * std::fabs(median) ? " (missing slice?)" : "");
+      if (!report.unreadable_files.empty())
+        m << "; the folder holds " << report.unreadable_files.size()
+          << " file(s) that could not be read as DICOM: " << unreadableList(report);
       throw InputError(m.str());
     }
   }
@@ -213,6 +225,22 @@ void checkSlices(const std::vector<std::string>& files, const itk::ImageSeriesRe
   report.slice_spacing_mm = std::fabs(median);
   report.slice_spacing_spread_mm = spread;
   spacing_out = std::fabs(median);
+}
+
+// Files of the folder in no series (GDCM could not read them): named in a
+// warning, and in the message when the series then lacks a slice.
+void noteUnreadableFiles(const fs::path& folder, itk::GDCMSeriesFileNames& names, ReadReport& report) {
+  std::set<std::string> in_series;
+  for (const std::string& uid : names.GetSeriesUIDs())
+    for (const std::string& f : names.GetFileNames(uid)) in_series.insert(fs::path(f).filename().string());
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec))
+    if (entry.is_regular_file(ec) && !in_series.count(entry.path().filename().string()))
+      report.unreadable_files.push_back(entry.path().filename().string());
+  std::sort(report.unreadable_files.begin(), report.unreadable_files.end());
+  if (!report.unreadable_files.empty())
+    log::warn(std::to_string(report.unreadable_files.size()) + " file(s) of " + folder.string() +
+              " are in no DICOM series (not DICOM, or unreadable): " + unreadableList(report));
 }
 
 Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport& report) {
@@ -248,7 +276,10 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
   report.series_uid = chosen->uid;
   report.modality = chosen->modality;
 
-  const std::vector<std::string> files = names->GetFileNames(chosen->uid);
+  // GDCM keys its series by UID in a sorted map and GetFileNames("") gives
+  // the first, so "" names the series of empty UID exactly.
+  const std::vector<std::string> files = names->GetFileNames(chosen->uid == kEmptySeriesUid ? "" : chosen->uid);
+  noteUnreadableFiles(folder, *names, report);
   using ReaderType = itk::ImageSeriesReader<itk::Image<float, 3>>;
   auto reader = ReaderType::New();
   auto io = itk::GDCMImageIO::New();
@@ -279,9 +310,36 @@ void checkDirection(const Eigen::Matrix3d& direction, const std::string& where) 
   }
 }
 
+namespace {
+// Every file of the folder is checked before GDCM scans it (dicom_check.hpp):
+// a damaged DICOM file is refused by name; files that are no DICOM at all
+// (a README, a DICOMDIR without preamble) are left for GDCM to skip.
+void refuseDamagedDicomFiles(const fs::path& folder) {
+  std::vector<std::string> damaged;
+  int count = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    if (!entry.is_regular_file(ec)) continue;
+    const DicomFileCheck check = checkDicomFile(entry.path());
+    if (check.kind != DicomFileKind::Damaged) continue;
+    if (++count <= 5) damaged.push_back(excerpt(entry.path().filename().string()) + ": " + check.problem);
+  }
+  if (damaged.empty()) return;
+  std::string list;
+  for (const auto& d : damaged) list += "\n  " + d;
+  throw InputError("expected complete DICOM files in " + folder.string() + ", found " + std::to_string(count) +
+                   " damaged (cut short or corrupted; replace or remove them):" + list +
+                   (count > 5 ? "\n  ..." : ""));
+}
+}  // namespace
+
 std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
   if (!fs::is_directory(folder)) throw InputError("expected a DICOM folder, found no folder at " + folder.string());
   if (fs::is_empty(folder)) throw InputError("expected DICOM files in " + folder.string() + ", found an empty folder");
+  refuseDamagedDicomFiles(folder);
+  // ITK's own warnings (e.g. on slices it skipped) would precede ours; what
+  // they say is checked and reported here.
+  itk::Object::GlobalWarningDisplayOff();
   std::vector<SeriesInfo> out;
   try {
     auto names = itk::GDCMSeriesFileNames::New();
@@ -289,7 +347,7 @@ std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
     names->SetDirectory(folder.string());
     for (const std::string& uid : names->GetSeriesUIDs()) {
       SeriesInfo s;
-      s.uid = uid;
+      s.uid = uid.empty() ? kEmptySeriesUid : uid;  // choosable by name
       const auto files = names->GetFileNames(uid);
       s.files = static_cast<int>(files.size());
       if (!files.empty()) readHeader(files.front(), s.modality, s.description);
