@@ -15,6 +15,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
+#include "articula/core/number_text.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/fits_json.hpp"
@@ -158,11 +159,20 @@ class ErrorsCommand : public cli::Command {
       std::ostream& out = file.stream();
       out << "x_mm,y_mm,z_mm";
       for (const auto& s : shapes) out << ",d_" << geometry::modelName(s.model) << "_mm";
-      out << "\n" << std::setprecision(12);
+      out << "\n";
+      std::string row;
       for (Eigen::Index i = 0; i < P.rows(); ++i) {
-        out << P(i, 0) << ',' << P(i, 1) << ',' << P(i, 2);
-        for (Eigen::Index m = 0; m < all.cols(); ++m) out << ',' << all(i, m);
-        out << '\n';
+        row.clear();
+        for (int k = 0; k < 3; ++k) {
+          if (k) row += ',';
+          appendNumber(row, P(i, k));
+        }
+        for (Eigen::Index m = 0; m < all.cols(); ++m) {
+          row += ',';
+          appendNumber(row, all(i, m));
+        }
+        row += '\n';
+        out << row;
       }
       file.commit();
     }

@@ -11,6 +11,7 @@ endmacro()
 find_package(Eigen3 3.4 QUIET NO_MODULE)
 articula_require(Eigen3_FOUND libeigen3-dev)
 
+find_package(Threads REQUIRED)
 find_package(OpenSSL QUIET)
 articula_require(OpenSSL_FOUND libssl-dev)
 

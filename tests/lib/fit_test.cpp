@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
+#include "articula/core/parallel.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
@@ -239,6 +240,39 @@ TEST(FitHierarchy, DeterministicForAFixedSeed) {
     EXPECT_EQ(a.fits[i].evaluations, b.fits[i].evaluations);
   }
   expectNested(a);
+}
+
+// Many points: the hierarchy is fitted on a seeded random sample, then every
+// model is finished on all the points. It ends where fitting all of them
+// does (well within one standard error), and neither the seed nor the number
+// of threads changes the result beyond the sample's own choice.
+TEST(FitHierarchy, SampleThenAllPointsReachesTheFullOptimum) {
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Superellipsoid), 1.2, 12000, 0.1, 31);
+  Options all;
+  all.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid, ShapeModel::Superellipsoid};
+  Options sampled = all;
+  sampled.sample_points = 2000;
+  const Summary full = articula::fit::fitHierarchy(pts, all);
+  const Summary part = articula::fit::fitHierarchy(pts, sampled);
+  ASSERT_EQ(full.fits.size(), part.fits.size());
+  expectNested(part);
+  for (size_t i = 0; i < full.fits.size(); ++i) {
+    const auto& f = full.fits[i];
+    const auto& p = part.fits[i];
+    const std::string model = articula::geometry::modelName(f.parameters.model);
+    EXPECT_NE(p.started_from.find("random sample of 2000 of the 12000 points"), std::string::npos) << p.started_from;
+    EXPECT_LE(p.rms_mm, f.rms_mm * (1 + 1e-5)) << model << ": " << p.termination;
+    // The same surface where the points are (axis labellings may differ):
+    // within a tenth of the noise.
+    const Eigen::VectorXd gap = articula::distance::signedDistances(p.parameters, pts) -
+                                articula::distance::signedDistances(f.parameters, pts);
+    EXPECT_LT(gap.cwiseAbs().maxCoeff(), 0.01) << model;
+  }
+  articula::setWorkerThreads(1);
+  const Summary one_thread = articula::fit::fitHierarchy(pts, sampled);
+  articula::setWorkerThreads(0);
+  for (size_t i = 0; i < part.fits.size(); ++i)
+    EXPECT_EQ(articula::geometry::toVector(one_thread.fits[i].parameters), articula::geometry::toVector(part.fits[i].parameters));
 }
 
 TEST(FitHierarchy, AlgebraicObjectiveKeepsNesting) {

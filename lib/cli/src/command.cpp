@@ -8,16 +8,13 @@
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
 #include "articula/core/log.hpp"
+#include "articula/core/parallel.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/core/version.hpp"
 
 namespace articula::cli {
 
-int CommonOptions::threadCount() const {
-  if (threads > 0) return threads;
-  unsigned n = std::thread::hardware_concurrency();
-  return n ? static_cast<int>(n) : 1;
-}
+int CommonOptions::threadCount() const { return threads > 0 ? threads : workerThreads(); }
 
 void addCommonOptions(CLI::App& app, CommonOptions& common) {
   app.set_version_flag("--version", versionString());
@@ -79,6 +76,7 @@ int guarded(Body&& body) {
 
 void applyCommon(const CommonOptions& common) {
   log::setLevel(static_cast<log::Level>(common.verbosity));
+  setWorkerThreads(common.threads);
   if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer, found " + std::to_string(common.seed));
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/LU>
 
+#include "articula/core/parallel.hpp"
 #include "articula/distance/ellipsoid_distance.hpp"
 #include "articula/geometry/pose.hpp"
 
@@ -246,12 +247,17 @@ void SignedDistance::evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d
     warm = false;
     feet.resize(n, 3);
   }
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Vector3d x = points.row(i).transpose();
-    const ClosestPoint c = warm ? closestFrom(x, feet.row(i).transpose()) : closest(x);
-    d[i] = c.distance;
-    feet.row(i) = c.point.transpose();
-  }
+  // The seeds are built lazily by closest(); once, before threads share them.
+  constexpr Eigen::Index kChunk = 2048;
+  if (n >= 2 * kChunk && workerThreads() > 1 && !isQuadric(shape_.model) && seeds_.rows() == 0) buildSeeds();
+  parallelFor(n, kChunk, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    for (Eigen::Index i = begin; i < end; ++i) {
+      const Vector3d x = points.row(i).transpose();
+      const ClosestPoint c = warm ? closestFrom(x, feet.row(i).transpose()) : closest(x);
+      d[i] = c.distance;
+      feet.row(i) = c.point.transpose();
+    }
+  });
 }
 
 Eigen::VectorXd signedDistances(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points) {

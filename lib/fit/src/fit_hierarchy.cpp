@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <random>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -62,6 +64,8 @@ void Options::validate() const {
   require(screening_evaluations >= 0 && screening_points >= 0 && restarts >= 0,
           "screening_evaluations, screening_points, restarts: expected >= 0");
   require(screening_finalists >= 1, "screening_finalists: expected >= 1");
+  require(sample_points == 0 || sample_points >= 1000, "sample_points: expected 0 (all) or >= 1000");
+  require(refine_evaluations >= 1, "refine_evaluations: expected >= 1");
   require(relative_tolerance >= 0.0 && parameter_tolerance >= 0.0, "tolerances: expected >= 0");
   require(radius_interval > 0.0 && radius_interval < 1.0, "radius_interval: expected in (0, 1)");
   require(center_interval > 0.0, "center_interval: expected > 0");
@@ -701,6 +705,151 @@ std::string Summary::fullReport() const {
   return s.str();
 }
 
+namespace {
+
+// The algebraic starts (thesis section 3.2.4) that seed the sphere and the
+// ellipsoid and centre the bounds of every model.
+struct AlgebraicStarts {
+  ShapeParameters sphere, ellipsoid;
+  bool have_ellipsoid = false;
+};
+
+AlgebraicStarts algebraicStarts(const Eigen::MatrixX3d& points) {
+  AlgebraicStarts a;
+  a.sphere = algebraicSphere(points);
+  a.ellipsoid = geometry::promote(a.sphere, ShapeModel::Ellipsoid);
+  try {
+    const ShapeParameters e = algebraicEllipsoid(points);
+    // Reject an algebraic ellipsoid that is far from the data's scale (a flat cap).
+    const double r = a.sphere.radii[0];
+    if (e.radii.maxCoeff() < 3.0 * r && e.radii.minCoeff() > r / 3.0) {
+      a.ellipsoid = e;
+      a.have_ellipsoid = true;
+    }
+  } catch (const ProcessingError& e) {
+    log::debug(std::string("ellipsoid-specific start unavailable: ") + e.what());
+  }
+  return a;
+}
+
+// Every model of the hierarchy; a model not fitted has 0 evaluations.
+struct HierarchyFits {
+  Fitted sphere, ellipsoid, superellipsoid, ovoid, superovoid;
+};
+
+bool wanted(const Options& o, ShapeModel m) { return std::find(o.models.begin(), o.models.end(), m) != o.models.end(); }
+
+// Progress of long fits on stderr, one line per model.
+void reportModel(const Fitted& f, bool long_run) {
+  const std::string line = "fit: " + geometry::modelName(f.fit.parameters.model) + " rms " +
+                           std::to_string(f.fit.rms_mm) + " mm (" + std::to_string(f.fit.seconds) + " s)";
+  long_run ? log::info(line) : log::debug(line);
+}
+
+HierarchyFits fitAll(const Eigen::MatrixX3d& points, const AlgebraicStarts& a, const Options& o, bool long_run) {
+  auto bounds = [&](ShapeModel m) { return makeBounds(m, a.ellipsoid, a.sphere, o); };
+  HierarchyFits h;
+  h.sphere = fitModel(ShapeModel::Sphere, {{"algebraic", a.sphere, {}}}, bounds(ShapeModel::Sphere), points, o);
+  reportModel(h.sphere, long_run);
+  std::vector<Start> e_starts{{"sphere", h.sphere.fit.parameters, h.sphere.feet}};
+  if (a.have_ellipsoid) e_starts.push_back({"algebraic", a.ellipsoid, {}});
+  h.ellipsoid =
+      fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o, o.screening_evaluations);
+  enforceNesting(h.ellipsoid, h.sphere, points, bounds(ShapeModel::Ellipsoid));
+  reportModel(h.ellipsoid, long_run);
+
+  const bool need_se = wanted(o, ShapeModel::Superellipsoid) || wanted(o, ShapeModel::Superovoid);
+  const bool need_o = wanted(o, ShapeModel::Ovoid) || wanted(o, ShapeModel::Superovoid);
+  if (need_se) {
+    h.superellipsoid = fitModel(ShapeModel::Superellipsoid, superellipsoidStarts(h.ellipsoid),
+                                bounds(ShapeModel::Superellipsoid), points, o, o.screening_evaluations);
+    enforceNesting(h.superellipsoid, h.ellipsoid, points, bounds(ShapeModel::Superellipsoid));
+    reportModel(h.superellipsoid, long_run);
+  }
+  if (need_o) {
+    h.ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(h.ellipsoid), bounds(ShapeModel::Ovoid), points, o,
+                       o.screening_evaluations);
+    enforceNesting(h.ovoid, h.ellipsoid, points, bounds(ShapeModel::Ovoid));
+    reportModel(h.ovoid, long_run);
+  }
+  if (wanted(o, ShapeModel::Superovoid)) {
+    // Every labelling of the superellipsoid: which axis the asymmetry takes
+    // decided the optimum reached on the real femoral head (measured).
+    std::vector<Start> so_starts = axisLabellings(h.superellipsoid);
+    so_starts.push_back({"ovoid", h.ovoid.fit.parameters, h.ovoid.feet});
+    so_starts.push_back({"ovoid with the superellipsoid's exponents",
+                         combineParents(h.superellipsoid.fit.parameters, h.ovoid.fit.parameters), {}});
+    h.superovoid = fitModel(ShapeModel::Superovoid, so_starts, bounds(ShapeModel::Superovoid), points, o,
+                            o.screening_evaluations);
+    enforceNesting(h.superovoid, h.superellipsoid.fit.rms_mm <= h.ovoid.fit.rms_mm ? h.superellipsoid : h.ovoid,
+                   points, bounds(ShapeModel::Superovoid));
+    reportModel(h.superovoid, long_run);
+  }
+  return h;
+}
+
+// A seeded random sample of `count` of the points, in their original order.
+Eigen::MatrixX3d randomSample(const Eigen::MatrixX3d& points, Eigen::Index count, unsigned seed) {
+  std::vector<Eigen::Index> index(static_cast<size_t>(points.rows()));
+  std::iota(index.begin(), index.end(), Eigen::Index{0});
+  std::mt19937_64 random(seed);
+  for (Eigen::Index i = 0; i < count; ++i) {  // a partial Fisher-Yates shuffle
+    std::uniform_int_distribution<Eigen::Index> pick(i, points.rows() - 1);
+    std::swap(index[static_cast<size_t>(i)], index[static_cast<size_t>(pick(random))]);
+  }
+  std::sort(index.begin(), index.begin() + count);
+  Eigen::MatrixX3d out(count, 3);
+  for (Eigen::Index i = 0; i < count; ++i) out.row(i) = points.row(index[static_cast<size_t>(i)]);
+  return out;
+}
+
+// Every model fitted on a sample, finished on all the points from its
+// optimum there (a few Levenberg-Marquardt steps: the sample's optimum is
+// within its standard errors of the full one), nesting checked again.
+HierarchyFits refineAll(const HierarchyFits& on_sample, Eigen::Index sample_size, const Eigen::MatrixX3d& points,
+                        const AlgebraicStarts& a, const Options& o) {
+  auto bounds = [&](ShapeModel m) { return makeBounds(m, a.ellipsoid, a.sphere, o); };
+  // From so near the optimum, steps that gain less than 1e-8 of the squared
+  // sum (an RMS change of 5e-9 relative) are not worth ~0.5 s each at 10^6 points.
+  Options finish = o;
+  finish.max_evaluations = o.refine_evaluations;
+  finish.restarts = 0;
+  finish.relative_tolerance = std::max(o.relative_tolerance, 1e-8);
+  const std::string note = " (fitted on a random sample of " + std::to_string(sample_size) + " of the " +
+                           std::to_string(points.rows()) + " points, then on all)";
+  // `parent`: a refined parent, whose closest points on all the points are
+  // warm starts for its child (as in fitAll), sparing a global search.
+  auto refine = [&](const Fitted& coarse, const Fitted* parent) {
+    if (coarse.fit.evaluations == 0) return coarse;
+    const ShapeModel model = coarse.fit.parameters.model;
+    Eigen::MatrixX3d feet;
+    if (parent && parent->feet.rows() == points.rows()) feet = parent->feet;
+    Fitted f = fitModel(model, {{coarse.fit.started_from, coarse.fit.parameters, feet}}, bounds(model), points, finish);
+    log::debug("fit: " + geometry::modelName(model) + " finished on all points in " + std::to_string(f.fit.evaluations) +
+               " evaluations, " + std::to_string(f.fit.seconds) + " s (" + f.fit.termination + ")");
+    f.fit.started_from += note;
+    f.fit.evaluations += coarse.fit.evaluations;
+    f.fit.seconds += coarse.fit.seconds;
+    reportModel(f, true);
+    return f;
+  };
+  HierarchyFits h;
+  h.sphere = refine(on_sample.sphere, nullptr);
+  h.ellipsoid = refine(on_sample.ellipsoid, &h.sphere);
+  enforceNesting(h.ellipsoid, h.sphere, points, bounds(ShapeModel::Ellipsoid));
+  h.superellipsoid = refine(on_sample.superellipsoid, &h.ellipsoid);
+  if (h.superellipsoid.fit.evaluations > 0)
+    enforceNesting(h.superellipsoid, h.ellipsoid, points, bounds(ShapeModel::Superellipsoid));
+  h.ovoid = refine(on_sample.ovoid, &h.ellipsoid);
+  if (h.ovoid.fit.evaluations > 0) enforceNesting(h.ovoid, h.ellipsoid, points, bounds(ShapeModel::Ovoid));
+  const Fitted& so_parent = h.superellipsoid.fit.rms_mm <= h.ovoid.fit.rms_mm ? h.superellipsoid : h.ovoid;
+  h.superovoid = refine(on_sample.superovoid, &so_parent);
+  if (h.superovoid.fit.evaluations > 0) enforceNesting(h.superovoid, so_parent, points, bounds(ShapeModel::Superovoid));
+  return h;
+}
+
+}  // namespace
+
 Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   o.validate();
   const auto t0 = Clock::now();
@@ -710,63 +859,23 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
                      std::to_string(points.rows()));
   if (!points.allFinite()) throw InputError("fit: points contain NaN or Inf");
 
-  const ShapeParameters sphere_start = algebraicSphere(points);
-  ShapeParameters ellipsoid_start = geometry::promote(sphere_start, ShapeModel::Ellipsoid);
-  bool have_algebraic_ellipsoid = false;
-  try {
-    const ShapeParameters e = algebraicEllipsoid(points);
-    // Reject an algebraic ellipsoid that is far from the data's scale (a flat cap).
-    const double r = sphere_start.radii[0];
-    if (e.radii.maxCoeff() < 3.0 * r && e.radii.minCoeff() > r / 3.0) {
-      ellipsoid_start = e;
-      have_algebraic_ellipsoid = true;
-    }
-  } catch (const ProcessingError& e) {
-    log::debug(std::string("ellipsoid-specific start unavailable: ") + e.what());
-  }
-
-  auto bounds = [&](ShapeModel m) { return makeBounds(m, ellipsoid_start, sphere_start, o); };
-  const Fitted sphere = fitModel(ShapeModel::Sphere, {{"algebraic", sphere_start, {}}}, bounds(ShapeModel::Sphere),
-                                 points, o);
-  std::vector<Start> e_starts{{"sphere", sphere.fit.parameters, sphere.feet}};
-  if (have_algebraic_ellipsoid) e_starts.push_back({"algebraic", ellipsoid_start, {}});
-  Fitted ellipsoid =
-      fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o, o.screening_evaluations);
-  enforceNesting(ellipsoid, sphere, points, bounds(ShapeModel::Ellipsoid));
-
-  auto wanted = [&](ShapeModel m) { return std::find(o.models.begin(), o.models.end(), m) != o.models.end(); };
-  const bool need_se = wanted(ShapeModel::Superellipsoid) || wanted(ShapeModel::Superovoid);
-  const bool need_o = wanted(ShapeModel::Ovoid) || wanted(ShapeModel::Superovoid);
-  Fitted superellipsoid, ovoid, superovoid;
-  if (need_se) {
-    superellipsoid = fitModel(ShapeModel::Superellipsoid, superellipsoidStarts(ellipsoid),
-                              bounds(ShapeModel::Superellipsoid), points, o, o.screening_evaluations);
-    enforceNesting(superellipsoid, ellipsoid, points, bounds(ShapeModel::Superellipsoid));
-  }
-  if (need_o) {
-    ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(ellipsoid), bounds(ShapeModel::Ovoid), points, o,
-                     o.screening_evaluations);
-    enforceNesting(ovoid, ellipsoid, points, bounds(ShapeModel::Ovoid));
-  }
-  if (wanted(ShapeModel::Superovoid)) {
-    // Every labelling of the superellipsoid: which axis the asymmetry takes
-    // decided the optimum reached on the real femoral head (measured).
-    std::vector<Start> so_starts = axisLabellings(superellipsoid);
-    so_starts.push_back({"ovoid", ovoid.fit.parameters, ovoid.feet});
-    so_starts.push_back({"ovoid with the superellipsoid's exponents",
-                         combineParents(superellipsoid.fit.parameters, ovoid.fit.parameters), {}});
-    superovoid = fitModel(ShapeModel::Superovoid, so_starts, bounds(ShapeModel::Superovoid), points, o,
-                          o.screening_evaluations);
-    enforceNesting(superovoid, superellipsoid.fit.rms_mm <= ovoid.fit.rms_mm ? superellipsoid : ovoid, points,
-                   bounds(ShapeModel::Superovoid));
+  HierarchyFits h;
+  if (o.sample_points > 0 && points.rows() > o.sample_points) {
+    log::info("fit: " + std::to_string(points.rows()) + " points: fitting on a random sample of " +
+              std::to_string(o.sample_points) + ", then on all");
+    const Eigen::MatrixX3d sample = randomSample(points, o.sample_points, o.seed);
+    const AlgebraicStarts a = algebraicStarts(sample);
+    h = refineAll(fitAll(sample, a, o, true), o.sample_points, points, a, o);
+  } else {
+    h = fitAll(points, algebraicStarts(points), o, false);
   }
 
   Summary summary;
   summary.points = static_cast<int>(points.rows());
-  for (const Fitted* f : std::initializer_list<const Fitted*>{&sphere, &ellipsoid, &superellipsoid, &ovoid, &superovoid})
-    if (wanted(f->fit.parameters.model) && f->fit.evaluations > 0) {
+  for (const Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid})
+    if (wanted(o, f->fit.parameters.model) && f->fit.evaluations > 0) {
       summary.fits.push_back(f->fit);
-      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points);
+      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet);
     }
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)

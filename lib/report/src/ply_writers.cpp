@@ -3,6 +3,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "articula/core/number_text.hpp"
+
 namespace articula::report {
 
 std::string colouredPointsPly(const Eigen::MatrixX3d& points, const Eigen::VectorXd& d, double band_mm,
@@ -14,11 +16,17 @@ std::string colouredPointsPly(const Eigen::MatrixX3d& points, const Eigen::Vecto
       << "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty double signed_distance_mm\n"
       << "end_header\n"
       << std::setprecision(12);
+  std::string text = out.str();
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
-    const char* rgb = d[i] < -band_mm ? "255 0 0" : d[i] > band_mm ? "0 0 255" : "0 200 0";
-    out << points(i, 0) << ' ' << points(i, 1) << ' ' << points(i, 2) << ' ' << rgb << ' ' << d[i] << '\n';
+    for (int k = 0; k < 3; ++k) {
+      appendNumber(text, points(i, k));
+      text += ' ';
+    }
+    text += d[i] < -band_mm ? "255 0 0 " : d[i] > band_mm ? "0 0 255 " : "0 200 0 ";
+    appendNumber(text, d[i]);
+    text += '\n';
   }
-  return out.str();
+  return text;
 }
 
 std::string meshPly(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles, const std::string& comment) {
@@ -28,7 +36,7 @@ std::string meshPly(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& tr
       << "element face " << triangles.rows() << "\nproperty list uchar int vertex_indices\nend_header\n"
       << std::setprecision(12);
   for (Eigen::Index i = 0; i < vertices.rows(); ++i)
-    out << vertices(i, 0) << ' ' << vertices(i, 1) << ' ' << vertices(i, 2) << '\n';
+    out << vertices(i, 0) << ' ' << vertices(i, 1) << ' ' << vertices(i, 2) << '\n';  // a patch: few vertices
   for (Eigen::Index i = 0; i < triangles.rows(); ++i)
     out << "3 " << triangles(i, 0) << ' ' << triangles(i, 1) << ' ' << triangles(i, 2) << '\n';
   return out.str();

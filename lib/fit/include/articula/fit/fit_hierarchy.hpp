@@ -55,6 +55,9 @@ struct Options {
   int screening_evaluations = 40;      // models with several starts: evaluations per start before the best is finished
   int screening_points = 400;          // screen the starts on about this many of the points (every k-th; 0 = all)
   int screening_finalists = 3;         // then finish this many of the best (distinct) on all points
+  int sample_points = 50000;           // more points: fit on a seeded random sample of this many, then
+                                       // finish every model on all of them (0 = always all)
+  int refine_evaluations = 20;         // per model, when finishing on all the points
   double relative_tolerance = 1e-12;   // on the objective (ftol_rel)
   double parameter_tolerance = 1e-10;  // on the parameters (xtol_rel)
   // Bounds (thesis section 3.2.5), around the reference ellipsoid start:

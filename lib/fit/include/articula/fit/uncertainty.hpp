@@ -21,8 +21,11 @@ struct ParameterUncertainty {
   double condition_number = 0;              // of J^T J with unit-scaled columns
 };
 
-/// The uncertainty of `fitted` (a least-squares optimum) on `points` (#P x 3).
+/// The uncertainty of `fitted` (a least-squares optimum) on `points` (#P x 3);
+/// `closest`: the points' closest points on `fitted` if known (#P x 3, else
+/// empty), which spares their global search.
 /// Throws InputError when there are no more points than parameters.
-ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points);
+ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points,
+                                          const Eigen::MatrixX3d& closest = {});
 
 }  // namespace articula::fit
