@@ -788,35 +788,38 @@ HierarchyFits fitAll(const Eigen::MatrixX3d& points, const AlgebraicStarts& a, c
   return h;
 }
 
-// A seeded random sample of `count` of the points, in their original order.
-Eigen::MatrixX3d randomSample(const Eigen::MatrixX3d& points, Eigen::Index count, unsigned seed) {
-  std::vector<Eigen::Index> index(static_cast<size_t>(points.rows()));
-  std::iota(index.begin(), index.end(), Eigen::Index{0});
-  std::mt19937_64 random(seed);
-  for (Eigen::Index i = 0; i < count; ++i) {  // a partial Fisher-Yates shuffle
-    std::uniform_int_distribution<Eigen::Index> pick(i, points.rows() - 1);
-    std::swap(index[static_cast<size_t>(i)], index[static_cast<size_t>(pick(random))]);
+// Nested seeded random samples: the first `count` of one seeded shuffle of
+// the points, in their original order (a larger sample holds every smaller one).
+class NestedSamples {
+ public:
+  NestedSamples(Eigen::Index n, unsigned seed) : order_(static_cast<size_t>(n)) {
+    std::iota(order_.begin(), order_.end(), Eigen::Index{0});
+    std::shuffle(order_.begin(), order_.end(), std::mt19937_64(seed));
   }
-  std::sort(index.begin(), index.begin() + count);
-  Eigen::MatrixX3d out(count, 3);
-  for (Eigen::Index i = 0; i < count; ++i) out.row(i) = points.row(index[static_cast<size_t>(i)]);
-  return out;
-}
+  Eigen::MatrixX3d take(const Eigen::MatrixX3d& points, Eigen::Index count) const {
+    std::vector<Eigen::Index> index(order_.begin(), order_.begin() + count);
+    std::sort(index.begin(), index.end());
+    Eigen::MatrixX3d out(count, 3);
+    for (Eigen::Index i = 0; i < count; ++i) out.row(i) = points.row(index[static_cast<size_t>(i)]);
+    return out;
+  }
 
-// Every model fitted on a sample, finished on all the points from its
-// optimum there (a few Levenberg-Marquardt steps: the sample's optimum is
-// within its standard errors of the full one), nesting checked again.
-HierarchyFits refineAll(const HierarchyFits& on_sample, Eigen::Index sample_size, const Eigen::MatrixX3d& points,
-                        const AlgebraicStarts& a, const Options& o) {
+ private:
+  std::vector<Eigen::Index> order_;
+};
+
+// Every model fitted on a sample, finished on a larger set of points from
+// its optimum there (a few Levenberg-Marquardt steps: the sample's optimum is
+// within its standard errors of the larger one's), nesting checked again.
+HierarchyFits refineAll(const HierarchyFits& on_sample, const Eigen::MatrixX3d& points, const AlgebraicStarts& a,
+                        const Options& o) {
   auto bounds = [&](ShapeModel m) { return makeBounds(m, a.ellipsoid, a.sphere, o); };
-  // From so near the optimum, steps that gain less than 1e-8 of the squared
-  // sum (an RMS change of 5e-9 relative) are not worth ~0.5 s each at 10^6 points.
+  // From so near the optimum, steps that gain less than 1e-7 of the squared
+  // sum (an RMS change of 5e-8 relative) are not worth ~0.5 s each at 10^6 points.
   Options finish = o;
   finish.max_evaluations = o.refine_evaluations;
   finish.restarts = 0;
-  finish.relative_tolerance = std::max(o.relative_tolerance, 1e-8);
-  const std::string note = " (fitted on a random sample of " + std::to_string(sample_size) + " of the " +
-                           std::to_string(points.rows()) + " points, then on all)";
+  finish.relative_tolerance = std::max(o.relative_tolerance, 1e-7);
   // `parent`: a refined parent, whose closest points on all the points are
   // warm starts for its child (as in fitAll), sparing a global search.
   auto refine = [&](const Fitted& coarse, const Fitted* parent) {
@@ -825,12 +828,12 @@ HierarchyFits refineAll(const HierarchyFits& on_sample, Eigen::Index sample_size
     Eigen::MatrixX3d feet;
     if (parent && parent->feet.rows() == points.rows()) feet = parent->feet;
     Fitted f = fitModel(model, {{coarse.fit.started_from, coarse.fit.parameters, feet}}, bounds(model), points, finish);
-    log::debug("fit: " + geometry::modelName(model) + " finished on all points in " + std::to_string(f.fit.evaluations) +
-               " evaluations, " + std::to_string(f.fit.seconds) + " s (" + f.fit.termination + ")");
-    f.fit.started_from += note;
+    log::debug("fit: " + geometry::modelName(model) + " finished on " + std::to_string(points.rows()) + " points in " +
+               std::to_string(f.fit.evaluations) + " evaluations, " + std::to_string(f.fit.seconds) + " s (" +
+               f.fit.termination + ")");
+    f.fit.started_from = coarse.fit.started_from;
     f.fit.evaluations += coarse.fit.evaluations;
     f.fit.seconds += coarse.fit.seconds;
-    reportModel(f, true);
     return f;
   };
   HierarchyFits h;
@@ -861,11 +864,25 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
 
   HierarchyFits h;
   if (o.sample_points > 0 && points.rows() > o.sample_points) {
+    // Fitted on a sample, then finished on samples four times larger up to
+    // all the points: each stage starts within a few steps of its optimum,
+    // and most steps are taken where they are cheap.
     log::info("fit: " + std::to_string(points.rows()) + " points: fitting on a random sample of " +
-              std::to_string(o.sample_points) + ", then on all");
-    const Eigen::MatrixX3d sample = randomSample(points, o.sample_points, o.seed);
-    const AlgebraicStarts a = algebraicStarts(sample);
-    h = refineAll(fitAll(sample, a, o, true), o.sample_points, points, a, o);
+              std::to_string(o.sample_points) + ", then on larger ones up to all");
+    const NestedSamples samples(points.rows(), o.seed);
+    Eigen::Index size = o.sample_points;
+    const Eigen::MatrixX3d first = samples.take(points, size);
+    const AlgebraicStarts a = algebraicStarts(first);
+    h = fitAll(first, a, o, true);
+    while (size < points.rows()) {
+      size = 8 * size >= points.rows() ? points.rows() : 4 * size;  // no stage of more than half the points
+      h = refineAll(h, size == points.rows() ? points : samples.take(points, size), a, o);
+      for (const Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid})
+        if (f->fit.evaluations > 0) reportModel(*f, true);
+    }
+    const std::string note = " (fitted on a random sample of " + std::to_string(o.sample_points) + " of the " +
+                             std::to_string(points.rows()) + " points, then on all)";
+    for (Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid}) f->fit.started_from += note;
   } else {
     h = fitAll(points, algebraicStarts(points), o, false);
   }
