@@ -126,6 +126,12 @@ done
 expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --max-radius 1e6
 grep -q "max-radius (mm): expected 1 to 60" "$tmp/err" || fail "max-radius: $(cat "$tmp/err")"
 expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --close-radius 1000
+expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --surface-hu nan
+grep -q "surface-hu (HU): expected -2000 to 40000, found nan" "$tmp/err" || fail "surface-hu: $(cat "$tmp/err")"
+expect_rc 2 "$A" sample -i "$tmp/head.csv" -o "$tmp/s.ply" --max-radius 1e300
+grep -q "expected 0 < min < max <= 200 mm" "$tmp/err" || fail "sample max-radius: $(cat "$tmp/err")"
+expect_rc 2 "$A" sample -i "$tmp/head.csv" -o "$tmp/s.ply" --band 1e300
+[ ! -e "$tmp/r.nii.gz" ] && [ ! -e "$tmp/s.ply" ] || fail "an output was written for an option out of range"
 expect_rc 2 "$A" nosuch --help
 grep -q "unknown command 'nosuch'" "$tmp/err" || fail "nosuch --help: $(cat "$tmp/err")"
 # Manifest columns the batch sets itself, or that no stage has: refused by

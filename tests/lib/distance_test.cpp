@@ -139,6 +139,19 @@ TEST_P(DistanceTest, WarmStartAgreesWithGlobalSearch) {
   Eigen::MatrixX3d guesses = mesh.vertices;
   field.evaluate(pts, warm, guesses, true);
   EXPECT_LT((cold - warm).cwiseAbs().maxCoeff(), 1e-9);
+  // Exact from any guesses, even poor ones (points of another surface, the
+  // far side of this one): the same distances as the global search, points
+  // deep inside included.
+  Eigen::MatrixX3d deep = pts;
+  deep.bottomRows(pts.rows() / 4) *= 0.3;
+  Eigen::VectorXd reference, exact;
+  Eigen::MatrixX3d reference_feet;
+  field.evaluate(deep, reference, reference_feet);
+  Eigen::MatrixX3d far_guesses = -mesh.vertices * 1.2;
+  field.evaluate(deep, exact, far_guesses, SignedDistance::Start::WarmExact);
+  EXPECT_LT((reference - exact).cwiseAbs().maxCoeff(), 1e-9);
+  for (Eigen::Index i = deep.rows() - 1; i >= 0; i -= 15)
+    EXPECT_NEAR(exact[i], bruteForceDistance(*surface, deep.row(i).transpose()), 1e-9) << "point " << i;
 }
 
 INSTANTIATE_TEST_SUITE_P(AllModels, DistanceTest,

@@ -208,7 +208,18 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     if (!newton(y, start, c)) c = descent(y, start);
     return c;
   };
-  ClosestPoint best = solve(seeds_.row(nearest).transpose());
+  ClosestPoint best;
+  const Vector3d first = seeds_.row(nearest).transpose();
+  if (newton(y, first, best)) {
+    // A stationary point with y on its outer side is y's projection onto the
+    // convex body: the global minimum, no other seed can do better.
+    if (best.distance > 0.0) {
+      best.point = rotation_ * best.point + pose_.translation;
+      return best;
+    }
+  } else {
+    best = descent(y, first);
+  }
   // Any nearer local minimum lies within one seed spacing of some seed that
   // is closer than |d| + spacing to y: try those far from minima already found.
   const double h = seed_spacing_;
@@ -230,6 +241,15 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
   return best;
 }
 
+ClosestPoint SignedDistance::closestExactFrom(const Vector3d& x, const Vector3d& guess) const {
+  if (isQuadric(shape_.model)) return closest(x);
+  const Vector3d y = rotation_.transpose() * (x - pose_.translation);
+  ClosestPoint c;
+  if (!newton(y, rotation_.transpose() * (guess - pose_.translation), c) || !(c.distance > 0.0)) return closest(x);
+  c.point = rotation_ * c.point + pose_.translation;
+  return c;
+}
+
 ClosestPoint SignedDistance::closestFrom(const Vector3d& x, const Vector3d& guess) const {
   if (isQuadric(shape_.model)) return closest(x);
   const Vector3d y = rotation_.transpose() * (x - pose_.translation);
@@ -240,11 +260,11 @@ ClosestPoint SignedDistance::closestFrom(const Vector3d& x, const Vector3d& gues
 }
 
 void SignedDistance::evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d, Eigen::MatrixX3d& feet,
-                              bool warm) const {
+                              Start start) const {
   const Eigen::Index n = points.rows();
   d.resize(n);
-  if (!warm || feet.rows() != n) {
-    warm = false;
+  if (feet.rows() != n) {
+    start = Start::Cold;
     feet.resize(n, 3);
   }
   // The seeds are built lazily by closest(); once, before threads share them.
@@ -253,7 +273,9 @@ void SignedDistance::evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d
   parallelFor(n, kChunk, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       const Vector3d x = points.row(i).transpose();
-      const ClosestPoint c = warm ? closestFrom(x, feet.row(i).transpose()) : closest(x);
+      const ClosestPoint c = start == Start::Warm        ? closestFrom(x, feet.row(i).transpose())
+                             : start == Start::WarmExact ? closestExactFrom(x, feet.row(i).transpose())
+                                                         : closest(x);
       d[i] = c.distance;
       feet.row(i) = c.point.transpose();
     }

@@ -474,10 +474,12 @@ ShapeParameters wrapAngles(ShapeParameters p) {
 }
 
 // The RMS of the exact signed distances (the global closest points, into
-// `feet`), whatever the objective: what is reported and nested.
+// `feet`), whatever the objective: what is reported and nested. `feet` on
+// entry: closest points on a nearby surface, if known, that spare most global
+// searches without making the result any less exact.
 double exactRms(const ShapeParameters& p, const Eigen::MatrixX3d& points, double& sse, Eigen::MatrixX3d& feet) {
   VectorXd d;
-  distance::SignedDistance(p).evaluate(points, d, feet);
+  distance::SignedDistance(p).evaluate(points, d, feet, distance::SignedDistance::Start::WarmExact);
   sse = d.squaredNorm();
   return std::sqrt(sse / static_cast<double>(points.rows()));
 }
@@ -580,6 +582,7 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
     best.evaluations += evaluations;
     if (run.value < best_value) {
       best_value = run.value;
+      fitted.feet = run.feet;  // guesses for the exact distances below
       best.parameters = wrapAngles(releaseOvoidScales(geometry::fromVector(model, run.x), model_bounds));
       best.termination = how + o.local_algorithm + ": " + run.termination;
       best.converged = run.converged;
@@ -677,6 +680,7 @@ void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::Ma
   for (Eigen::Index i = 0; i < promoted.size(); ++i)
     if (bounds.given[static_cast<size_t>(i)] && !(promoted[i] >= bounds.lower[i] && promoted[i] <= bounds.upper[i])) return;
   child.parameters = geometry::promote(parent.parameters, model);
+  fitted.feet = parent_fitted.feet;
   child.rms_mm = exactRms(child.parameters, points, child.sse_mm2, fitted.feet);
   child.algebraic_objective = algebraicObjective(child.parameters, points);
   child.termination += "; kept the " + geometry::modelName(parent.parameters.model) + " (fit was not better)";

@@ -42,7 +42,7 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
                      std::to_string(n));
   Eigen::VectorXd residual;
   Eigen::MatrixX3d feet = closest;
-  distance::SignedDistance(fitted).evaluate(points, residual, feet, feet.rows() == n);
+  distance::SignedDistance(fitted).evaluate(points, residual, feet, distance::SignedDistance::Start::WarmExact);
   Eigen::MatrixXd J;
   Eigen::VectorXd gradient_norms;
   parameterGradient(fitted, feet, J, gradient_norms);

@@ -200,6 +200,7 @@ void SegmentOptions::validate() const {
   range(hu_min, -2000, 10000, "--hu-min (HU)");
   range(hu_max, -2000, 40000, "--hu-max (HU)");
   if (!(hu_min < hu_max)) throw UsageError("--hu-min must be below --hu-max");
+  range(surface_hu, -2000, 40000, "--surface-hu (HU)");
   if (roi_min.has_value() != roi_max.has_value()) throw UsageError("--roi needs both corners");
   if (roi_min && (roi_max->array() <= roi_min->array()).any())
     throw UsageError("--roi: expected xmin,ymin,zmin,xmax,ymax,zmax with min < max");

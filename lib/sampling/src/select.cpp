@@ -73,8 +73,14 @@ void SelectOptions::validate() const {
   if (mode == Mode::Sphere && !(radius > 0)) throw UsageError("--select sphere: the radius must be > 0");
   if (mode == Mode::Box && (box_max.array() <= box_min.array()).any())
     throw UsageError("--select box: expected XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX with min < max");
-  if (!(min_radius_mm > 0 && min_radius_mm < max_radius_mm)) throw UsageError("sphere radius range must satisfy 0 < min < max");
-  if (!(band_mm > 0)) throw UsageError("selection band must be > 0 mm");
+  // Joint heads are 15-35 mm in radius; 200 mm and a 50 mm band leave room
+  // for any anatomy while keeping RANSAC's search bounded.
+  if (!(min_radius_mm > 0 && min_radius_mm < max_radius_mm && max_radius_mm <= 200))
+    throw UsageError("--min-radius/--max-radius: expected 0 < min < max <= 200 mm, found " + std::to_string(min_radius_mm) +
+                     " and " + std::to_string(max_radius_mm));
+  if (!(band_mm > 0 && band_mm <= 50)) throw UsageError("--band: expected a band in (0, 50] mm, found " + std::to_string(band_mm));
+  if (mode == Mode::Sphere && !(radius <= 1e5 && center.allFinite()))
+    throw UsageError("--select sphere: expected a finite centre and a radius up to 1e5 mm");
   if (!(normal_deg > 0 && normal_deg <= 90)) throw UsageError("normal tolerance must be in (0, 90] degrees");
   if (min_points < 1) throw UsageError("minimum selected points must be >= 1");
 }

@@ -42,10 +42,27 @@ class SignedDistance {
   /// Exact whenever `guess` lies in the basin of the global minimum.
   ClosestPoint closestFrom(const Eigen::Vector3d& x, const Eigen::Vector3d& guess) const;
 
+  /// The global minimum like closest(), started from `guess`: a point
+  /// outside whose local minimum is found from there needs no global search
+  /// (the projection onto a convex body is its only stationary point with the
+  /// point on the outer side); every other point gets closest().
+  ClosestPoint closestExactFrom(const Eigen::Vector3d& x, const Eigen::Vector3d& guess) const;
+
+  /// How evaluate() uses `feet` on entry.
+  enum class Start {
+    Cold,        // ignored: closest() for every point (exact)
+    Warm,        // guesses, refined locally (closestFrom: fitting)
+    WarmExact,   // guesses that spare global searches (closestExactFrom: exact)
+  };
+
   /// Signed distances of `points` (#P x 3) into `d` (#P) and closest points
-  /// into `feet` (#P x 3). With `warm` = true, `feet` on entry hold guesses
-  /// (closestFrom); otherwise closest() is used.
-  void evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d, Eigen::MatrixX3d& feet, bool warm = false) const;
+  /// into `feet` (#P x 3); `feet` on entry are used as `start` says when
+  /// they have #P rows.
+  void evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d, Eigen::MatrixX3d& feet, Start start) const;
+  /// evaluate() with Start::Warm when `warm`, else Start::Cold.
+  void evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d, Eigen::MatrixX3d& feet, bool warm = false) const {
+    evaluate(points, d, feet, warm ? Start::Warm : Start::Cold);
+  }
 
  private:
   bool newton(const Eigen::Vector3d& x, const Eigen::Vector3d& start, ClosestPoint& result) const;
