@@ -857,6 +857,15 @@ HierarchyFits refineAll(const HierarchyFits& on_sample, const Eigen::MatrixX3d& 
 
 }  // namespace
 
+ModelFit fitFrom(const ShapeParameters& start, const Eigen::MatrixX3d& points, const Options& o) {
+  o.validate();
+  const AlgebraicStarts a = algebraicStarts(points);
+  const Bounds b = makeBounds(start.model, a.ellipsoid, a.sphere, o);
+  Fitted f = fitModel(start.model, {{"given start", start, {}}}, b, points, o);
+  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet);
+  return f.fit;
+}
+
 Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   o.validate();
   const auto t0 = Clock::now();

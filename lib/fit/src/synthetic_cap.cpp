@@ -3,7 +3,10 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/Geometry>
+
 #include "articula/geometry/fibonacci.hpp"
+#include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
 
 namespace articula::fit {
@@ -28,6 +31,30 @@ Eigen::MatrixX3d syntheticCap(const geometry::ShapeParameters& shape, double hal
     pts.row(i) = x.transpose();
   }
   return pts;
+}
+
+geometry::ShapeParameters randomHeadShape(geometry::ShapeModel model, double radius_spread, unsigned seed) {
+  using geometry::ShapeModel;
+  std::mt19937 rng(seed);
+  auto uniform = [&rng](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  geometry::ShapeParameters p;
+  p.model = model;
+  const double r0 = uniform(18.0, 28.0);
+  for (int k = 0; k < 3; ++k) p.radii[k] = r0 * (1.0 + uniform(-0.5, 0.5) * radius_spread);
+  if (model == ShapeModel::Sphere) p.radii.setConstant(r0);
+  if (model == ShapeModel::Superellipsoid || model == ShapeModel::Superovoid)
+    for (int k = 0; k < 3; ++k) p.exponents[k] = uniform(2.0, 3.0);
+  if (model == ShapeModel::Ovoid || model == ShapeModel::Superovoid) {
+    p.cx = Eigen::Vector4d(1.0, uniform(0.0, 0.1), uniform(-0.03, 0.03), uniform(-0.03, 0.03));
+    p.cy = Eigen::Vector4d(1.0, uniform(0.0, 0.1), uniform(-0.03, 0.03), uniform(-0.03, 0.03));
+  }
+  // A uniformly random rotation: a normalised Gaussian quaternion.
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Eigen::Quaterniond q(gauss(rng), gauss(rng), gauss(rng), gauss(rng));
+  q.normalize();
+  if (model != ShapeModel::Sphere) p.angles = geometry::anglesFromRotation(q.toRotationMatrix());
+  p.center = Eigen::Vector3d(uniform(-50, 50), uniform(-50, 50), uniform(-50, 50));
+  return p;
 }
 
 }  // namespace articula::fit

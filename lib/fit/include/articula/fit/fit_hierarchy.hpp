@@ -100,6 +100,11 @@ struct Summary {
 /// ProcessingError if no start can be found (degenerate points).
 Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& options = {});
 
+/// One model, fitted locally from `start` alone (its model is start.model),
+/// within the bounds fitHierarchy would use: e.g. the reference "started at
+/// the true parameters" of the oracle benchmark.
+ModelFit fitFrom(const geometry::ShapeParameters& start, const Eigen::MatrixX3d& points, const Options& options = {});
+
 /// The thesis objective eq. 3.1 and the geometric SSE (mm^2) of a shape.
 double algebraicObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
 double geometricObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);

@@ -13,4 +13,11 @@ namespace articula::fit {
 Eigen::MatrixX3d syntheticCap(const geometry::ShapeParameters& shape, double half_angle, int n, double sigma,
                               unsigned seed);
 
+/// A random head-like shape of `model` for oracle benchmarks and tests
+/// (deterministic for `seed`): radii r0 (18-28 mm) times factors within
+/// `radius_spread` of each other (0.03: as near-spherical as real femoral
+/// heads), exponents 2-3, ovoid coefficients c1 0-0.1 and c2, c3 within
+/// +-0.03, a uniformly random orientation, a centre within 50 mm of the origin.
+geometry::ShapeParameters randomHeadShape(geometry::ShapeModel model, double radius_spread, unsigned seed);
+
 }  // namespace articula::fit
