@@ -275,6 +275,24 @@ TEST(FitHierarchy, SampleThenAllPointsReachesTheFullOptimum) {
     EXPECT_EQ(articula::geometry::toVector(one_thread.fits[i].parameters), articula::geometry::toVector(part.fits[i].parameters));
 }
 
+// The exact-cap oracle of bench-fit-oracle on some of its near-spherical
+// cases (radii within 3 %, random orientation, same seeds): 0 is reachable,
+// so each family's own RMS must be <= 0.01 mm.
+TEST(FitHierarchy, ExactNearSphericalCapsReachZero) {
+  const ShapeModel families[] = {ShapeModel::Superellipsoid, ShapeModel::Ovoid, ShapeModel::Superovoid};
+  for (int f = 0; f < 3; ++f)
+    for (int k : {0, 2, 4}) {
+      const unsigned seed = 1000003u + static_cast<unsigned>(f * 100000 + k);
+      const ShapeParameters truth = articula::fit::randomHeadShape(families[f], 0.03, seed);
+      std::mt19937 rng(seed);
+      const double half_angle = std::uniform_real_distribution<double>(70.0, 110.0)(rng) * M_PI / 180.0;
+      const Eigen::MatrixX3d pts = articula::fit::syntheticCap(truth, half_angle, 1500, 0.0, seed);
+      const Summary s = articula::fit::fitHierarchy(pts, Options{});
+      EXPECT_LE(s.fit(families[f]).rms_mm, 0.01) << articula::geometry::modelName(families[f]) << " seed " << seed;
+      expectNested(s);
+    }
+}
+
 TEST(FitHierarchy, AlgebraicObjectiveKeepsNesting) {
   const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Ovoid), 1.3, 600, 0.1, 5);
   Options o;
