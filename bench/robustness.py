@@ -81,6 +81,7 @@ def run_ct(ct, bin_dir, work):
             s = subprocess.run([f"{bin_dir}/bench-score-head", f"{d}/ct/truth.json", side, f"{out}/points.ply",
                                 f"{out}/results.json"], check=True, capture_output=True, text=True)
             row.update(json.loads(s.stdout))
+            row["selected"] = json.load(open(f"{out}/results.json")).get("selected_model")
             limit = 0.5 * min(ct["spacing"][0], ct["spacing"][1])
             ok = row["rms_mm"] <= limit and row["share_within_1p5_mm"] >= 0.95
             row["verdict"] = "correct" if ok else "SILENTLY WRONG"
@@ -121,6 +122,18 @@ def table(rows):
     return "\n".join(lines)
 
 
+def confusion(rows):
+    """The selected model against the true one, over the heads run to the end."""
+    lines = ["| true \\ selected | " + " | ".join(MODELS) + " | heads | correct |",
+             "|---|" + "---|" * (len(MODELS) + 2)]
+    for true in MODELS:
+        g = [r for r in rows if r["exit"] == 0 and r["true_model"] == true]
+        counts = [sum(r.get("selected") == m for r in g) for m in MODELS]
+        lines.append(f"| {true} | " + " | ".join(map(str, counts)) + f" | {len(g)} | "
+                     f"{100.0 * counts[MODELS.index(true)] / len(g) if g else 0:.0f} % |")
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--bin", default="build/bin")
@@ -142,7 +155,7 @@ def main():
                 print(f"{r['id']} {r['side']}: {r['verdict']} (exit {r['exit']}, {r['seconds']} s)", file=sys.stderr)
     rows.sort(key=lambda r: (r["id"], r["side"]))
     json.dump(rows, open(os.path.join(args.work, "robustness.json"), "w"), indent=1)
-    text = table(rows)
+    text = table(rows) + "\n\nSelected model against the true model:\n\n" + confusion(rows)
     open(os.path.join(args.work, "robustness.md"), "w").write(text + "\n")
     print(text)
     print(f"\n{len(rows)} heads from {len(cts)} CTs in {time.time() - t0:.0f} s wall with -j {args.j}", file=sys.stderr)

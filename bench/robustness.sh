@@ -8,7 +8,8 @@
 # RMS to the true surface <= half the in-plane voxel and >= 95 % of them
 # within 1.5 mm), refused (exit != 0) or SILENTLY WRONG (exit 0, not
 # correct). Prints a markdown table of the shares per spacing group and one
-# row per head; writes WORK/robustness.md and WORK/robustness.json.
+# row per head, then the selected model against the true model (a confusion
+# matrix); writes WORK/robustness.md and WORK/robustness.json.
 #   bash bench/robustness.sh [-j N] [--quick] [build/bin] [WORK]
 # Needs build/bin/articula and build/bin/bench-score-head (the scorer).
 set -euo pipefail
