@@ -395,6 +395,30 @@ TEST_F(PointsTest, BadPlyDataNamesTheLineOrVertex) {
   EXPECT_TRUE(contains(m, "99999999999")) << m;
 }
 
+// Found by fuzzing (fuzz/fuzz_ply): a list length of float type read as 5e31 or
+// NaN was converted to an integer (undefined behaviour), and a binary element
+// without properties declared 2^64-1 times was counted through record by record.
+TEST_F(PointsTest, PlyListLengthsAndEmptyElementsAreBounded) {
+  std::string data;
+  for (double v : {1.0, 2.0, 3.0}) appendLittleEndian(data, v);
+  const std::string vertex = "element vertex 1\nproperty double x\nproperty double y\nproperty double z\n";
+  std::string m = readError(writeFile("float_count.ply",
+                                      "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                                      "property list float int8 vertex_indices\n" +
+                                          vertex + "end_header\n" + std::string(4, '\xff') + data));
+  EXPECT_TRUE(contains(m, "line 4") && contains(m, "integer type") && contains(m, "'float'")) << m;
+  m = readError(writeFile("nan_count.ply",
+                          "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n" + vertex +
+                              "end_header\nnan 1 2\n1 2 3\n"));
+  EXPECT_TRUE(contains(m, "line 10") && contains(m, "non-negative integer list length")) << m;
+
+  const PointCloud cloud = readPoints(writeFile(
+      "empty_elements.ply", "ply\nformat binary_little_endian 1.0\nelement marker 18446744073709551615\n" + vertex +
+                                "end_header\n" + data));
+  ASSERT_EQ(cloud.positions.rows(), 1);
+  EXPECT_EQ(cloud.positions(0, 2), 3.0);
+}
+
 TEST_F(PointsTest, MalformedPlyHeadersNameTheLine) {
   const std::pair<std::string, std::string> cases[] = {
       {"solid x\nformat ascii 1.0\n", "line 1"},
