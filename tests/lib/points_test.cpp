@@ -494,6 +494,36 @@ TEST_F(PointsTest, ReadsObjVerticesAndNormals) {
   EXPECT_EQ(no_normals.normals.rows(), 0);
 }
 
+// Found by fuzzing (fuzz/fuzz_mesh): VTK's OBJ reader read a face's vertex,
+// texture coordinate or normal index out of bounds (a crash) and copied a
+// material name into a 100-byte buffer; such files are refused by line.
+TEST_F(PointsTest, ObjIndicesOutsideTheFileAreRefusedByLine) {
+  const std::string vertices = "v 0 0 0\nv 1 0 0\nv 0 2 0\n";  // lines 1-3
+  const std::pair<std::string, std::string> cases[] = {
+      {"vn 0 0 1\nf 1 2 3\nf 1//1 2//1 4//1\n", "vertex index"},
+      {"vn 0 0 1\nf 1//1 2//1 3//2\n", "normal index"},
+      {"vt 0 0\nf 1/1 2/2 3/1\n", "texture coordinate index"},
+      {"f 0 1 2\n", "vertex index"},
+      {"f -4 1 2\n", "vertex index"},
+      {"f 1 2 99999999999\n", "at most 9 digits"},
+      {"l 1 2/x\n", "integer indices"},
+      {"l 1 2/1/1\n", "indices v or v/t"},
+      {"p 1/1\n", "indices v"},
+      {"f 1 2 \\\n 7\n", "vertex index"},  // a continued face
+      {"usemtl " + std::string(120, 'm') + "\nf 1 2 3\n", "material name"},
+  };
+  for (const auto& [tail, expected] : cases) {
+    const std::string m = readError(writeFile("bad.obj", vertices + tail));
+    EXPECT_TRUE(contains(m, "bad.obj") && contains(m, expected) && contains(m, "line ")) << tail << " -> " << m;
+  }
+  const std::string m = readError(writeFile("late.obj", vertices + "vn 0 0 1\nf 1//1 2//1 3//2\n"));
+  EXPECT_TRUE(contains(m, "line 5")) << m;
+
+  // Indices counting back from the last vertex, and normals defined after the faces, are fine.
+  const PointCloud cloud = readPoints(writeFile("relative.obj", vertices + "f -3//1 -2//1 -1//1\nvn 0 0 1\n"));
+  EXPECT_EQ(cloud.positions.rows(), 3);
+}
+
 TEST_F(PointsTest, ReadsVtpVerticesAndNormalsAndRejectsBrokenXml) {
   const std::string text = R"(<?xml version="1.0"?>
 <VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">
