@@ -2,6 +2,7 @@
 // bad-input checks refuse with exit code 3, and the head segmentation of the
 // phantom matches its truth; the real CTs give one plausible head.
 #include <fstream>
+#include <iterator>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -85,6 +86,31 @@ TEST(ImagingIo, BadFoldersAndFilesAreInputErrors) {
   std::ofstream(dir / "broken.nii.gz") << "garbage";
   EXPECT_THROW(imaging::readVolume(dir / "broken.nii.gz", {}), InputError);
   EXPECT_THROW(imaging::checkDirection(Eigen::Matrix3d::Constant(1.0), "test"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+// Found by fuzzing (fuzz/fuzz_nifti): the message of a damaged gzip stream
+// was read from zlib after the stream (and the message with it) was freed.
+TEST(ImagingIo, DamagedGzipStreamIsRefusedWithZlibsReason) {
+  const auto dir = testing::scratch("gzip");
+  imaging::Volume v;
+  v.geometry.size = Eigen::Vector3i(24, 24, 24);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  unsigned state = 12345;  // noise, so that the stream stays long
+  for (float& x : v.voxels) x = static_cast<float>((state = state * 1103515245u + 12345u) >> 20) - 2048.0f;
+  imaging::writeVolume(dir / "whole.nii.gz", v);
+  std::ifstream in(dir / "whole.nii.gz", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 4000u);
+  std::ofstream(dir / "cut.nii.gz", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  try {
+    imaging::readVolume(dir / "cut.nii.gz", {});
+    ADD_FAILURE() << "a cut gzip stream was read";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("damaged"), std::string::npos) << m;
+    EXPECT_NE(m.find("unexpected end of file"), std::string::npos) << m;
+  }
   std::filesystem::remove_all(dir);
 }
 

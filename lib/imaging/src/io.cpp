@@ -123,11 +123,15 @@ void checkNiftiFile(const fs::path& path) {
       for (int n; found < expected && (n = gzread(file, chunk.data(), static_cast<unsigned>(chunk.size()))) > 0;)
         found += n;
       int zerr = Z_OK;
+      // zlib owns the message and frees it with the stream: copied before gzclose.
       const char* zmessage = gzerror(file, &zerr);
+      std::string zlib_message = zmessage && *zmessage ? zmessage : "zlib error";
+      // gzerror puts the file name first; the message names it already.
+      if (zlib_message.rfind(path.string() + ": ", 0) == 0) zlib_message.erase(0, path.string().size() + 2);
       gzclose(file);
       if (zerr != Z_OK && zerr != Z_STREAM_END)
         throw InputError(path.string() + ": the compressed data is damaged after " + std::to_string(std::llround(found)) +
-                         " bytes (" + excerpt(zmessage ? zmessage : "zlib error") + "); expected " +
+                         " bytes (" + excerpt(zlib_message) + "); expected " +
                          std::to_string(std::llround(expected)) + " bytes of header and voxels");
       if (found < expected)
         throw InputError(path.string() + ": truncated: expected " + std::to_string(std::llround(expected)) +
