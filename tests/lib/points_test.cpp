@@ -565,6 +565,17 @@ TEST_F(PointsTest, GarbageMeshesAreInputErrors) {
   EXPECT_TRUE(contains(m, "truncated.stl")) << m;
 }
 
+// Found by fuzzing (fuzz/fuzz_mesh): a file starting with "solid" but holding
+// control bytes is binary to VTK, which allocated for the 1.9e9 triangles the
+// bytes 80-83 declared (gigabytes); the size check now decides binary as VTK does.
+TEST_F(PointsTest, StlThatVtkReadsAsBinaryIsCheckedForItsSize) {
+  std::string bytes = "solid tetra\n" + std::string(68, '\x1c');  // text to the eye, binary to VTK
+  bytes += "    ";                                                 // 0x20202020 triangles
+  bytes += std::string(100, '\x01');
+  const std::string m = readError(writeFile("solid_binary.stl", bytes));
+  EXPECT_TRUE(contains(m, "solid_binary.stl") && contains(m, "538976288 triangles")) << m;
+}
+
 TEST_F(PointsTest, ReadsTheRealFemurMesh) {
   const fs::path path = sharedData() / "meshes/femur/LHDL_CT_femur_r.stl";
   if (!fs::exists(path)) GTEST_SKIP() << "real data absent: " << path;
