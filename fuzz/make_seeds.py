@@ -2,7 +2,9 @@
 """Writes the seed corpora of the fuzz targets into fuzz/corpus/<target>/.
 
 Small valid inputs of every format a target reads (plus a few near misses);
-rerun after changing the formats. Each seed stays under a few KB."""
+rerun after changing the formats. Each seed stays under a few KB. The files
+named found_* are inputs the fuzzers once failed on, kept as regression
+seeds; this script does not write them."""
 import gzip
 import json
 import os

@@ -1,6 +1,9 @@
 // Imaging: file round trips (NIfTI, DICOM) keep the physical geometry, the
 // bad-input checks refuse with exit code 3, and the head segmentation of the
 // phantom matches its truth; the real CTs give one plausible head.
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <unistd.h>
@@ -111,6 +114,58 @@ TEST(ImagingIo, DamagedGzipStreamIsRefusedWithZlibsReason) {
     EXPECT_NE(m.find("damaged"), std::string::npos) << m;
     EXPECT_NE(m.find("unexpected end of file"), std::string::npos) << m;
   }
+  std::filesystem::remove_all(dir);
+}
+
+// A NIfTI-1 header (4x4x4 int16 unless changed) and its extension bytes;
+// `big` writes it big-endian.
+std::string niftiHeader(bool big, std::int16_t dim0, std::int16_t nx, std::int16_t ny, std::int16_t nz,
+                        const char* magic = "n+1") {
+  std::string h(352, '\0');
+  auto put = [&](int at, auto value) {
+    unsigned char b[sizeof value];
+    std::memcpy(b, &value, sizeof value);
+    if (big) std::reverse(b, b + sizeof value);
+    std::memcpy(&h[static_cast<size_t>(at)], b, sizeof value);
+  };
+  put(0, std::int32_t{348});
+  const std::int16_t dims[8] = {dim0, nx, ny, nz, 1, 1, 1, 1};
+  for (int i = 0; i < 8; ++i) put(40 + 2 * i, dims[i]);
+  put(70, std::int16_t{4});
+  put(72, std::int16_t{16});
+  for (int i = 0; i < 8; ++i) put(76 + 4 * i, 1.0f);
+  put(108, 352.0f);
+  put(112, 1.0f);
+  std::memcpy(&h[344], magic, 4);
+  return h;
+}
+
+// Found by fuzzing (fuzz/fuzz_nifti): ITK allocated the image a header
+// declared before reading a voxel (a header of 2.5e8 voxels in a file of 350
+// bytes took 1.5 GB): an Analyze-style .nii (no "n+1" magic) was not measured,
+// nor a header whose byte order nifti1_io takes from dim[0] against its size.
+TEST(ImagingIo, NiftiHeadersPromisingMoreThanTheFileHoldsAreRefused) {
+  const auto dir = testing::scratch("nifti_size");
+  auto refused = [&](const std::string& name, const std::string& bytes, const std::string& part) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    try {
+      imaging::readVolume(dir / name, {});
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << name << ": " << e.what();
+    }
+  };
+  const std::string voxels(4 * 4 * 4 * 2, '\0');
+  std::ofstream(dir / "ok.nii", std::ios::binary) << niftiHeader(false, 3, 4, 4, 4) + voxels;
+  EXPECT_EQ(imaging::readVolume(dir / "ok.nii", {}).geometry.size, Eigen::Vector3i(4, 4, 4));
+
+  refused("analyze.nii", niftiHeader(false, 3, 26414, 122, 77, "\0\0\0\0") + voxels, "truncated");
+  // Header size 348 little-endian, dim[0] valid big-endian only: nifti1_io reads big-endian dims.
+  std::string swapped = niftiHeader(true, 3, 30000, 30000, 30000);
+  const std::int32_t little_size = 348;
+  std::memcpy(&swapped[0], &little_size, 4);
+  refused("swapped.nii", swapped + voxels, "truncated");
+  refused("rank.nii", niftiHeader(false, 0, 4, 4, 4) + voxels, "dim[0]");
   std::filesystem::remove_all(dir);
 }
 
