@@ -3,21 +3,20 @@
 //   --pairs FILE.csv   one query per row (ellipsoid/superellipsoid pairs, or a plane for b)
 //   --scenario NAME    the prescribed motions of thesis tables 5.3 / 5.4, 200 warm-started steps
 //   --fits-a/--fits-b  two fitted surfaces (fits.json from articula-fit), each with an optional pose
+// The pairs file is read by lib/contact (pairs_csv.hpp).
 // Output: a CSV (LPS mm) and FILE.json with the summary and provenance;
 // --json prints the summary (with the median solver time per query).
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <map>
-#include <sstream>
 
 #include <Eigen/Geometry>
 
 #include "articula/cli/command.hpp"
 #include "articula/contact/common_normal.hpp"
+#include "articula/contact/pairs_csv.hpp"
 #include "articula/contact/plane_contact.hpp"
 #include "articula/contact/scenario.hpp"
 #include "articula/core/atomic_file.hpp"
@@ -34,78 +33,6 @@ using contact::ConvexShape;
 using Eigen::Vector3d;
 
 const char* kOutputHeader = "distance,pax,pay,paz,pbx,pby,pbz,nx,ny,nz,iterations,status";
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r"), e = s.find_last_not_of(" \t\r");
-  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-// A row that cannot be used: the reason goes to stderr and the JSON summary.
-struct BadRow : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-struct Row {
-  const std::map<std::string, size_t>& columns;
-  const std::vector<std::string>& cells;
-  const std::string& text(const std::string& name) const {
-    const auto it = columns.find(name);
-    if (it == columns.end()) throw BadRow("column '" + name + "' is missing from the header");
-    return cells[it->second];
-  }
-  bool empty(const std::string& name) const { return columns.count(name) == 0 || cells[columns.at(name)].empty(); }
-  double number(const std::string& name) const {
-    const std::string& text = this->text(name);
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size()) throw BadRow(name + ": expected a number, found '" + text + "'");
-    if (!std::isfinite(v)) throw BadRow(name + ": expected a finite number, found '" + text + "'");
-    return v;
-  }
-  Vector3d vec(const std::string& x, const std::string& y, const std::string& z) const {
-    return {number(x), number(y), number(z)};
-  }
-};
-
-// Shape "a" or "b" of a row; warns when the quaternion had to be normalised.
-// `kind` (shape_b): "sphere" and "ellipsoid" take empty exponent cells as 2
-// and reject others; "sphere" also needs three equal radii.
-ConvexShape rowShape(const Row& r, const std::string& s, int line, const std::string& kind = "") {
-  const Eigen::Vector4d q(r.number("qw_" + s), r.number("qx_" + s), r.number("qy_" + s), r.number("qz_" + s));
-  const double len = q.norm();
-  if (!(len > 1e-12)) throw BadRow("quaternion " + s + " is zero");
-  if (std::fabs(len - 1.0) > 1e-9)
-    log::warn("line " + std::to_string(line) + ": quaternion " + s + " has length " + std::to_string(len) +
-              "; normalised");
-  const Eigen::Matrix3d R = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
-  const Vector3d radii = r.vec("ra_" + s, "rb_" + s, "rc_" + s);
-  Vector3d exponents(2.0, 2.0, 2.0);
-  const bool quadric = kind == "sphere" || kind == "ellipsoid";
-  for (int i = 0; i < 3; ++i) {
-    const std::string column = "g" + std::to_string(i + 1) + "_" + s;
-    if (quadric && r.empty(column)) continue;
-    exponents[i] = r.number(column);
-    if (quadric && exponents[i] != 2.0)
-      throw BadRow(column + ": expected 2 or an empty cell (shape_" + s + " is " + kind + "), found " + r.text(column));
-  }
-  if (kind == "sphere" && !(radii.maxCoeff() - radii.minCoeff() <= 1e-12 * radii.maxCoeff()))
-    throw BadRow("shape_" + s + " is sphere: expected ra_" + s + " = rb_" + s + " = rc_" + s + ", found " +
-                 r.text("ra_" + s) + ", " + r.text("rb_" + s) + ", " + r.text("rc_" + s));
-  try {
-    return contact::makeConvexShape(r.vec("cx_" + s, "cy_" + s, "cz_" + s), R, radii, exponents);
-  } catch (const InvalidParameter& e) {
-    throw BadRow("shape " + s + ": " + e.what());
-  }
-}
 
 // One output row; `suffix` (e.g. ",123.4") goes before the newline.
 void writeRow(std::ostream& out, const ContactResult& r, const std::string& suffix = "") {
@@ -222,24 +149,7 @@ class ContactCommand : public cli::Command {
 
  private:
   int runPairs(const cli::CommonOptions& common) {
-    std::ifstream in(pairs_);
-    if (!in) throw InputError("cannot read --pairs file '" + pairs_.string() + "'");
-    std::string line;
-    if (!std::getline(in, line)) throw InputError(pairs_.string() + ": empty file (expected a header row)");
-    std::map<std::string, size_t> columns;
-    const auto header = splitCsv(line);
-    for (size_t i = 0; i < header.size(); ++i) columns[header[i]] = i;
-    std::vector<std::string> missing;
-    for (const char* s : {"a", "b"})
-      for (const char* c : {"cx", "cy", "cz"})
-        if (!columns.count(std::string(c) + "_" + s)) missing.push_back(std::string(c) + "_" + s);
-    for (const char* c : {"qw", "qx", "qy", "qz", "ra", "rb", "rc", "g1", "g2", "g3"})
-      if (!columns.count(std::string(c) + "_a")) missing.push_back(std::string(c) + "_a");
-    if (!missing.empty()) {
-      std::string list;
-      for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
-      throw InputError(pairs_.string() + ":1: header lacks column(s) " + list);
-    }
+    const std::vector<contact::PairRow> pairs = contact::readPairsCsv(pairs_);
 
     AtomicFile file(output_, common.force);
     std::ostream& out = file.stream();
@@ -248,40 +158,26 @@ class ContactCommand : public cli::Command {
     nlohmann::json invalid = nlohmann::json::array();
     int rows = 0, converged = 0, certified = 0, planes = 0;
     long long iterations = 0;
-    for (int line_no = 2; std::getline(in, line); ++line_no) {
-      if (trim(line).empty()) continue;
+    for (const contact::PairRow& pair : pairs) {
       ++rows;
-      const auto cells = splitCsv(line);
-      try {
-        if (cells.size() != header.size())
-          throw BadRow("expected " + std::to_string(header.size()) + " cells, found " + std::to_string(cells.size()));
-        const Row row{columns, cells};
-        const ConvexShape a = rowShape(row, "a", line_no);
-        std::string kind = row.empty("shape_b") ? "" : row.text("shape_b");
-        std::transform(kind.begin(), kind.end(), kind.begin(), [](unsigned char c) { return std::tolower(c); });
-        if (kind != "" && kind != "plane" && kind != "sphere" && kind != "ellipsoid" && kind != "superellipsoid")
-          throw BadRow("shape_b: expected plane, sphere, ellipsoid, superellipsoid or empty, found '" +
-                       row.text("shape_b") + "'");
-        const bool plane = kind == "plane";
-        ContactResult r;
-        if (plane) {
-          const Vector3d p = row.vec("cx_b", "cy_b", "cz_b"), n = row.vec("nx_b", "ny_b", "nz_b");
-          if (!(n.norm() > 0.0)) throw BadRow("plane normal nx_b,ny_b,nz_b is zero");
-          ns.push_back(timeNs([&] { r = contact::shapePlaneContact(a, p, n); }));
-          ++planes;
-        } else {
-          const ConvexShape b = rowShape(row, "b", line_no, kind);
-          ns.push_back(timeNs([&] { r = contact::computeContact(a, b, options_); }));
-        }
-        writeRow(out, r);
-        iterations += r.summary.iterations;
-        converged += r.summary.status == contact::ContactStatus::Converged;
-        certified += r.summary.certified;
-      } catch (const BadRow& e) {
-        log::warn(pairs_.string() + ":" + std::to_string(line_no) + ": " + e.what() + "; row marked invalid");
-        invalid.push_back({{"line", line_no}, {"reason", e.what()}});
+      for (const std::string& warning : pair.warnings) log::warn(warning);
+      if (!pair.valid) {
+        log::warn(pairs_.string() + ":" + std::to_string(pair.line) + ": " + pair.reason + "; row marked invalid");
+        invalid.push_back({{"line", pair.line}, {"reason", pair.reason}});
         out << "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,0,invalid\n";
+        continue;
       }
+      ContactResult r;
+      if (pair.plane) {
+        ns.push_back(timeNs([&] { r = contact::shapePlaneContact(pair.a, pair.plane_point, pair.plane_normal); }));
+        ++planes;
+      } else {
+        ns.push_back(timeNs([&] { r = contact::computeContact(pair.a, pair.b, options_); }));
+      }
+      writeRow(out, r);
+      iterations += r.summary.iterations;
+      converged += r.summary.status == contact::ContactStatus::Converged;
+      certified += r.summary.certified;
     }
     const int valid = rows - static_cast<int>(invalid.size());
     if (valid == 0)

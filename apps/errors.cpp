@@ -4,7 +4,6 @@
 // (histogram.svg), points coloured as fig. 3.4 (PLY, and flat maps in
 // error_map.svg) and each fitted surface (PLY).
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 
@@ -94,16 +93,7 @@ class ErrorsCommand : public cli::Command {
   int run(const cli::CommonOptions& common) override {
     const points::PointCloud cloud = points::readPoints(input_);
     points::checkFittable(cloud, 1, input_.string());
-    nlohmann::json doc;
-    {
-      std::ifstream in(fits_);
-      if (!in) throw InputError("--fits: cannot open '" + fits_.string() + "'");
-      try {
-        in >> doc;
-      } catch (const std::exception& e) {
-        throw InputError("--fits: '" + fits_.string() + "' is not valid JSON: " + e.what());
-      }
-    }
+    const nlohmann::json doc = fit::readFitsJson(fits_, "--fits");
     const std::vector<geometry::ShapeParameters> shapes = fit::shapesFromFitsJson(doc, fits_.string());
     if (std::filesystem::exists(output_) && !std::filesystem::is_directory(output_))
       throw UsageError("--output: expected a folder, found the file '" + output_.string() + "'");

@@ -1,7 +1,11 @@
 // Imaging: file round trips (NIfTI, DICOM) keep the physical geometry, the
 // bad-input checks refuse with exit code 3, and the head segmentation of the
 // phantom matches its truth; the real CTs give one plausible head.
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -85,6 +89,83 @@ TEST(ImagingIo, BadFoldersAndFilesAreInputErrors) {
   std::ofstream(dir / "broken.nii.gz") << "garbage";
   EXPECT_THROW(imaging::readVolume(dir / "broken.nii.gz", {}), InputError);
   EXPECT_THROW(imaging::checkDirection(Eigen::Matrix3d::Constant(1.0), "test"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+// Found by fuzzing (fuzz/fuzz_nifti): the message of a damaged gzip stream
+// was read from zlib after the stream (and the message with it) was freed.
+TEST(ImagingIo, DamagedGzipStreamIsRefusedWithZlibsReason) {
+  const auto dir = testing::scratch("gzip");
+  imaging::Volume v;
+  v.geometry.size = Eigen::Vector3i(24, 24, 24);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  unsigned state = 12345;  // noise, so that the stream stays long
+  for (float& x : v.voxels) x = static_cast<float>((state = state * 1103515245u + 12345u) >> 20) - 2048.0f;
+  imaging::writeVolume(dir / "whole.nii.gz", v);
+  std::ifstream in(dir / "whole.nii.gz", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 4000u);
+  std::ofstream(dir / "cut.nii.gz", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  try {
+    imaging::readVolume(dir / "cut.nii.gz", {});
+    ADD_FAILURE() << "a cut gzip stream was read";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("damaged"), std::string::npos) << m;
+    EXPECT_NE(m.find("unexpected end of file"), std::string::npos) << m;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A NIfTI-1 header (4x4x4 int16 unless changed) and its extension bytes;
+// `big` writes it big-endian.
+std::string niftiHeader(bool big, std::int16_t dim0, std::int16_t nx, std::int16_t ny, std::int16_t nz,
+                        const char* magic = "n+1") {
+  std::string h(352, '\0');
+  auto put = [&](int at, auto value) {
+    unsigned char b[sizeof value];
+    std::memcpy(b, &value, sizeof value);
+    if (big) std::reverse(b, b + sizeof value);
+    std::memcpy(&h[static_cast<size_t>(at)], b, sizeof value);
+  };
+  put(0, std::int32_t{348});
+  const std::int16_t dims[8] = {dim0, nx, ny, nz, 1, 1, 1, 1};
+  for (int i = 0; i < 8; ++i) put(40 + 2 * i, dims[i]);
+  put(70, std::int16_t{4});
+  put(72, std::int16_t{16});
+  for (int i = 0; i < 8; ++i) put(76 + 4 * i, 1.0f);
+  put(108, 352.0f);
+  put(112, 1.0f);
+  std::memcpy(&h[344], magic, 4);
+  return h;
+}
+
+// Found by fuzzing (fuzz/fuzz_nifti): ITK allocated the image a header
+// declared before reading a voxel (a header of 2.5e8 voxels in a file of 350
+// bytes took 1.5 GB): an Analyze-style .nii (no "n+1" magic) was not measured,
+// nor a header whose byte order nifti1_io takes from dim[0] against its size.
+TEST(ImagingIo, NiftiHeadersPromisingMoreThanTheFileHoldsAreRefused) {
+  const auto dir = testing::scratch("nifti_size");
+  auto refused = [&](const std::string& name, const std::string& bytes, const std::string& part) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    try {
+      imaging::readVolume(dir / name, {});
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << name << ": " << e.what();
+    }
+  };
+  const std::string voxels(4 * 4 * 4 * 2, '\0');
+  std::ofstream(dir / "ok.nii", std::ios::binary) << niftiHeader(false, 3, 4, 4, 4) + voxels;
+  EXPECT_EQ(imaging::readVolume(dir / "ok.nii", {}).geometry.size, Eigen::Vector3i(4, 4, 4));
+
+  refused("analyze.nii", niftiHeader(false, 3, 26414, 122, 77, "\0\0\0\0") + voxels, "truncated");
+  // Header size 348 little-endian, dim[0] valid big-endian only: nifti1_io reads big-endian dims.
+  std::string swapped = niftiHeader(true, 3, 30000, 30000, 30000);
+  const std::int32_t little_size = 348;
+  std::memcpy(&swapped[0], &little_size, 4);
+  refused("swapped.nii", swapped + voxels, "truncated");
+  refused("rank.nii", niftiHeader(false, 0, 4, 4, 4) + voxels, "dim[0]");
   std::filesystem::remove_all(dir);
 }
 

@@ -395,6 +395,30 @@ TEST_F(PointsTest, BadPlyDataNamesTheLineOrVertex) {
   EXPECT_TRUE(contains(m, "99999999999")) << m;
 }
 
+// Found by fuzzing (fuzz/fuzz_ply): a list length of float type read as 5e31 or
+// NaN was converted to an integer (undefined behaviour), and a binary element
+// without properties declared 2^64-1 times was counted through record by record.
+TEST_F(PointsTest, PlyListLengthsAndEmptyElementsAreBounded) {
+  std::string data;
+  for (double v : {1.0, 2.0, 3.0}) appendLittleEndian(data, v);
+  const std::string vertex = "element vertex 1\nproperty double x\nproperty double y\nproperty double z\n";
+  std::string m = readError(writeFile("float_count.ply",
+                                      "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                                      "property list float int8 vertex_indices\n" +
+                                          vertex + "end_header\n" + std::string(4, '\xff') + data));
+  EXPECT_TRUE(contains(m, "line 4") && contains(m, "integer type") && contains(m, "'float'")) << m;
+  m = readError(writeFile("nan_count.ply",
+                          "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n" + vertex +
+                              "end_header\nnan 1 2\n1 2 3\n"));
+  EXPECT_TRUE(contains(m, "line 10") && contains(m, "non-negative integer list length")) << m;
+
+  const PointCloud cloud = readPoints(writeFile(
+      "empty_elements.ply", "ply\nformat binary_little_endian 1.0\nelement marker 18446744073709551615\n" + vertex +
+                                "end_header\n" + data));
+  ASSERT_EQ(cloud.positions.rows(), 1);
+  EXPECT_EQ(cloud.positions(0, 2), 3.0);
+}
+
 TEST_F(PointsTest, MalformedPlyHeadersNameTheLine) {
   const std::pair<std::string, std::string> cases[] = {
       {"solid x\nformat ascii 1.0\n", "line 1"},
@@ -470,6 +494,36 @@ TEST_F(PointsTest, ReadsObjVerticesAndNormals) {
   EXPECT_EQ(no_normals.normals.rows(), 0);
 }
 
+// Found by fuzzing (fuzz/fuzz_mesh): VTK's OBJ reader read a face's vertex,
+// texture coordinate or normal index out of bounds (a crash) and copied a
+// material name into a 100-byte buffer; such files are refused by line.
+TEST_F(PointsTest, ObjIndicesOutsideTheFileAreRefusedByLine) {
+  const std::string vertices = "v 0 0 0\nv 1 0 0\nv 0 2 0\n";  // lines 1-3
+  const std::pair<std::string, std::string> cases[] = {
+      {"vn 0 0 1\nf 1 2 3\nf 1//1 2//1 4//1\n", "vertex index"},
+      {"vn 0 0 1\nf 1//1 2//1 3//2\n", "normal index"},
+      {"vt 0 0\nf 1/1 2/2 3/1\n", "texture coordinate index"},
+      {"f 0 1 2\n", "vertex index"},
+      {"f -4 1 2\n", "vertex index"},
+      {"f 1 2 99999999999\n", "at most 9 digits"},
+      {"l 1 2/x\n", "integer indices"},
+      {"l 1 2/1/1\n", "indices v or v/t"},
+      {"p 1/1\n", "indices v"},
+      {"f 1 2 \\\n 7\n", "vertex index"},  // a continued face
+      {"usemtl " + std::string(120, 'm') + "\nf 1 2 3\n", "material name"},
+  };
+  for (const auto& [tail, expected] : cases) {
+    const std::string m = readError(writeFile("bad.obj", vertices + tail));
+    EXPECT_TRUE(contains(m, "bad.obj") && contains(m, expected) && contains(m, "line ")) << tail << " -> " << m;
+  }
+  const std::string m = readError(writeFile("late.obj", vertices + "vn 0 0 1\nf 1//1 2//1 3//2\n"));
+  EXPECT_TRUE(contains(m, "line 5")) << m;
+
+  // Indices counting back from the last vertex, and normals defined after the faces, are fine.
+  const PointCloud cloud = readPoints(writeFile("relative.obj", vertices + "f -3//1 -2//1 -1//1\nvn 0 0 1\n"));
+  EXPECT_EQ(cloud.positions.rows(), 3);
+}
+
 TEST_F(PointsTest, ReadsVtpVerticesAndNormalsAndRejectsBrokenXml) {
   const std::string text = R"(<?xml version="1.0"?>
 <VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">
@@ -509,6 +563,17 @@ TEST_F(PointsTest, GarbageMeshesAreInputErrors) {
   truncated += std::string(100, '\0');
   const std::string m = readError(writeFile("truncated.stl", truncated));
   EXPECT_TRUE(contains(m, "truncated.stl")) << m;
+}
+
+// Found by fuzzing (fuzz/fuzz_mesh): a file starting with "solid" but holding
+// control bytes is binary to VTK, which allocated for the 1.9e9 triangles the
+// bytes 80-83 declared (gigabytes); the size check now decides binary as VTK does.
+TEST_F(PointsTest, StlThatVtkReadsAsBinaryIsCheckedForItsSize) {
+  std::string bytes = "solid tetra\n" + std::string(68, '\x1c');  // text to the eye, binary to VTK
+  bytes += "    ";                                                 // 0x20202020 triangles
+  bytes += std::string(100, '\x01');
+  const std::string m = readError(writeFile("solid_binary.stl", bytes));
+  EXPECT_TRUE(contains(m, "solid_binary.stl") && contains(m, "538976288 triangles")) << m;
 }
 
 TEST_F(PointsTest, ReadsTheRealFemurMesh) {

@@ -418,7 +418,9 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
     }
     std::sort(samples.begin(), samples.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
     std::vector<Vector3d> chosen;
-    for (const auto& [s, d] : samples) {
+    for (const auto& sample : samples) {
+      // A named reference, not a structured binding: lambdas may capture those only from C++20 (Clang refuses).
+      const Vector3d& d = sample.second;
       if (std::any_of(chosen.begin(), chosen.end(), [&](const Vector3d& c) { return c.dot(d) > 0.85; })) continue;
       chosen.push_back(d);
       solver.startFromDirection(d, nullptr);

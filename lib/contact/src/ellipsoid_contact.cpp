@@ -549,7 +549,10 @@ ContactResult ellipsoidContact(const ConvexShape& a, const ConvexShape& b, const
     std::sort(ends.begin(), ends.end(), [](const auto& l, const auto& r) { return l.first > r.first; });
     state.rival_count = 0;
     bool untracked = false;  // more rivals than a warm start follows: it searches again
-    for (const auto& [ceiling, v] : ends) {
+    for (const auto& end : ends) {
+      // Named references, not a structured binding: lambdas may capture those only from C++20 (Clang refuses).
+      const double ceiling = end.first;
+      const Vector3d& v = end.second;
       if (ceiling == -INFINITY || v.dot(best.v) > kSame ||
           std::any_of(state.rivals, state.rivals + state.rival_count, [&](const Vector3d& r) { return r.dot(v) > kSame; }))
         continue;

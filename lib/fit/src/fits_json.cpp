@@ -1,6 +1,7 @@
 #include "articula/fit/fits_json.hpp"
 
 #include <cmath>
+#include <fstream>
 
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
@@ -117,6 +118,18 @@ geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::
     throw InputError(where + ": " + e.what());
   }
   return p;
+}
+
+nlohmann::json readFitsJson(const std::filesystem::path& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw InputError(what + ": cannot open '" + path.string() + "'");
+  nlohmann::json doc;
+  try {
+    in >> doc;
+  } catch (const std::exception& e) {
+    throw InputError(what + ": '" + path.string() + "' is not valid JSON: " + e.what());
+  }
+  return doc;
 }
 
 std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where) {

@@ -78,10 +78,28 @@ void checkNiftiFile(const fs::path& path) {
     for (int i = 0; i < n; ++i) v |= std::uint64_t(header[at + (swap ? i : n - 1 - i)]) << (8 * (n - 1 - i));
     return v;  // little-endian read unless swapped
   };
-  for (bool swap : {false, true}) {
-    const auto size = static_cast<std::int32_t>(bytes(0, 4, swap));
+  for (bool order : {false, true}) {
+    const auto size = static_cast<std::int32_t>(bytes(0, 4, order));
     if (size != 348 && !(size == 540 && got >= 540)) continue;
     const bool v1 = size == 348;
+    // ITK reads NIfTI-1 with nifti1_io, which takes the byte order from dim[0]
+    // unless it is 0 (and only then from the header size): every field below
+    // is read in the order ITK will use, or the checks would judge other
+    // numbers than those ITK allocates for.
+    bool swap = order;
+    if (v1) {
+      const auto dim0 = static_cast<std::int16_t>(bytes(40, 2, false));
+      const auto dim0_swapped = static_cast<std::int16_t>(bytes(40, 2, true));
+      if (dim0 >= 1 && dim0 <= 7) {
+        swap = false;
+      } else if (dim0_swapped >= 1 && dim0_swapped <= 7) {
+        swap = true;
+      } else {
+        gzclose(file);
+        throw InputError(path.string() + ": the NIfTI header's dim[0] (the number of dimensions) is " +
+                         std::to_string(dim0) + "; expected 1 to 7");
+      }
+    }
     const auto real = [&](int at) {
       if (v1) {
         const auto bits = static_cast<std::uint32_t>(bytes(at, 4, swap));
@@ -107,32 +125,64 @@ void checkNiftiFile(const fs::path& path) {
                          "; expected a non-zero, finite size in mm");
       }
     }
-    // A single-file NIfTI must hold all its voxels: ITK reads a truncated file
-    // (or a truncated gzip stream) without complaint and fills the rest with
-    // zeros, so the stream is measured here, at the cost of one more decompression.
-    const bool single_file = std::memcmp(header + (v1 ? 344 : 4), v1 ? "n+1" : "n+2", 3) == 0;
+    // A .nii file must hold all its voxels: ITK allocates the whole image from
+    // the header before it reads any voxel (a header of 10^9 voxels in a file
+    // of a few bytes asked for gigabytes), and it reads a truncated file (or a
+    // truncated gzip stream) without complaint, filling the rest with zeros.
+    // So the stream is measured here, at the cost of one more decompression.
+    // For NIfTI-1 this holds whatever the magic says: ITK reads a .nii without
+    // "n+1" as an Analyze image, from the same file.
+    const bool single_file = v1 || std::memcmp(header + 4, "n+2", 3) == 0;
     const double rank = dim(0);
+    const auto datatype = static_cast<std::int16_t>(bytes(v1 ? 70 : 12, 2, swap));
     const double bitpix = double(static_cast<std::int16_t>(bytes(v1 ? 72 : 14, 2, swap)));
-    const double offset = v1 ? real(108) : double(static_cast<std::int64_t>(bytes(168, 8, swap)));
-    if (single_file && rank >= 1 && rank <= 7 && bitpix > 0 && offset >= size) {
+    // Bytes per voxel as nifti1_io takes them, from the datatype; bitpix only
+    // for a datatype it does not know (then it refuses the file anyway).
+    double voxel_bytes = 0;
+    switch (datatype) {
+      case 2: case 256: voxel_bytes = 1; break;                      // uint8, int8
+      case 4: case 512: voxel_bytes = 2; break;                      // int16, uint16
+      case 128: voxel_bytes = 3; break;                              // rgb24
+      case 8: case 16: case 768: case 2304: voxel_bytes = 4; break;  // int32, float32, uint32, rgba32
+      case 32: case 64: case 1024: case 1280: voxel_bytes = 8; break;  // complex64, float64, int64, uint64
+      case 1536: case 1792: voxel_bytes = 16; break;                 // float128, complex128
+      case 2048: voxel_bytes = 32; break;                            // complex256
+      default: voxel_bytes = std::max(bitpix / 8, 1.0);
+    }
+    const double stored_offset = v1 ? real(108) : double(static_cast<std::int64_t>(bytes(168, 8, swap)));
+    // The voxels start after the header, whatever the header says.
+    const double offset = std::isfinite(stored_offset) ? std::max(stored_offset, double(size)) : double(size);
+    if (single_file && rank >= 1 && rank <= 7) {
+      // Counts for messages; a header may promise more than a long long holds.
+      const auto number = [](double v) {
+        if (v < 9e18) return std::to_string(std::llround(v));
+        std::ostringstream text;
+        text << v;
+        return text.str();
+      };
       double voxels = 1;
       for (int i = 1; i <= rank; ++i) voxels *= std::max(dim(i), 1.0);
-      const double expected = offset + voxels * bitpix / 8;
+      const double expected = offset + voxels * voxel_bytes;
       double found = got;
       std::vector<unsigned char> chunk(1 << 20);
       for (int n; found < expected && (n = gzread(file, chunk.data(), static_cast<unsigned>(chunk.size()))) > 0;)
         found += n;
       int zerr = Z_OK;
+      // zlib owns the message and frees it with the stream: copied before gzclose.
       const char* zmessage = gzerror(file, &zerr);
+      std::string zlib_message = zmessage && *zmessage ? zmessage : "zlib error";
+      // gzerror puts the file name first; the message names it already.
+      if (zlib_message.rfind(path.string() + ": ", 0) == 0) zlib_message.erase(0, path.string().size() + 2);
       gzclose(file);
       if (zerr != Z_OK && zerr != Z_STREAM_END)
-        throw InputError(path.string() + ": the compressed data is damaged after " + std::to_string(std::llround(found)) +
-                         " bytes (" + excerpt(zmessage ? zmessage : "zlib error") + "); expected " +
-                         std::to_string(std::llround(expected)) + " bytes of header and voxels");
+        throw InputError(path.string() + ": the compressed data is damaged after " + number(found) +
+                         " bytes (" + excerpt(zlib_message) + "); expected " +
+                         number(expected) + " bytes of header and voxels");
       if (found < expected)
-        throw InputError(path.string() + ": truncated: expected " + std::to_string(std::llround(expected)) +
-                         " bytes of header and voxels (" + std::to_string(std::llround(voxels)) + " voxels of " +
-                         std::to_string(int(bitpix)) + " bits), found " + std::to_string(std::llround(found)));
+        throw InputError(path.string() + ": truncated: expected " + number(expected) +
+                         " bytes of header and voxels (" + number(voxels) + " voxels of " +
+                         number(voxel_bytes * 8) + " bits), found " +
+                         number(found));
       return;
     }
     gzclose(file);

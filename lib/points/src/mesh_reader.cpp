@@ -19,6 +19,8 @@
 #include <cctype>
 #include <cstdint>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "articula/core/error.hpp"
 #include "readers.hpp"
@@ -41,17 +43,23 @@ class ErrorCollector : public vtkCommand {
   std::string message;
 };
 
-// VTK 9.1 reads a truncated binary STL without complaint (it stops early), so check the size the
-// header promises: 80 bytes of text, a uint32 triangle count, 50 bytes per triangle.
+// VTK 9.1 reads a truncated binary STL without complaint (it stops early), and
+// allocates for the triangle count of the header before reading any, so check
+// the size the header promises: 80 bytes of text, a uint32 triangle count, 50
+// bytes per triangle. Which files are binary is decided as VTK decides it
+// (vtksys DetectFileType): 5% or more of the first 256 bytes outside printable
+// ASCII, tab, CR and LF; an ASCII header such as "solid" does not make it text.
 void checkBinaryStlSize(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  std::array<char, 84> head{};
+  std::array<char, 256> head{};
   in.read(head.data(), head.size());
   const auto got = static_cast<std::size_t>(in.gcount());
-  std::size_t start = 0;
-  while (start < got && std::isspace(static_cast<unsigned char>(head[start]))) ++start;
-  if (got - start >= 5 && std::string(head.data() + start, 5) == "solid") return;  // ASCII: VTK checks it
-  if (got < head.size())
+  const auto text = static_cast<std::size_t>(std::count_if(head.begin(), head.begin() + got, [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return (u >= 0x20 && u <= 0x7F) || u == '\n' || u == '\r' || u == '\t';
+  }));
+  if (got > 0 && static_cast<double>(got - text) / static_cast<double>(got) < 0.05) return;  // ASCII: VTK checks it
+  if (got < 84)
     throw InputError("mesh file " + quoted(path) +
                      ": expected an ASCII STL starting with 'solid' or a binary STL " +
                      "header of 84 bytes, found " + std::to_string(got) + " bytes of something else");
@@ -65,6 +73,98 @@ void checkBinaryStlSize(const std::filesystem::path& path) {
                      " bytes (truncated file?)");
 }
 
+// VTK 9.1's OBJ reader trusts the file's indices: a face naming a vertex,
+// texture coordinate or normal the file does not have is read out of bounds
+// (a crash), and a material name of 100 characters or more overflows its
+// buffer. So every index of 'f', 'l' and 'p' is checked here first, as VTK
+// resolves it (1-based; negative counts back from the elements read so far),
+// and anything VTK might read differently is refused rather than guessed.
+void checkObjReferences(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot open mesh file " + quoted(path) + " for reading");
+  auto words = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::size_t i = 0;
+    for (;;) {
+      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      if (i == line.size()) return out;
+      const std::size_t start = i;
+      while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      out.push_back(line.substr(start, i - start));
+    }
+  };
+  // First pass: how many of each the file holds (VTK reads positive indices against these totals).
+  std::array<long, 3> total{0, 0, 0};  // v, vt, vn
+  std::string line;
+  long line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    line = line.substr(0, line.find('\0'));  // VTK reads each line as a C string
+    const auto w = words(line);
+    if (w.empty()) continue;
+    if (w[0] == "v") ++total[0];
+    if (w[0] == "vt") ++total[1];
+    if (w[0] == "vn") ++total[2];
+    if (w[0] == "usemtl" && w.size() > 1 && w[1].size() >= 100)
+      throw InputError("mesh file " + quoted(path) + ", line " + std::to_string(line_number) +
+                       ": expected a material name of fewer than 100 characters, found " +
+                       std::to_string(w[1].size()));
+  }
+  in.clear();
+  in.seekg(0);
+  std::array<long, 3> so_far{0, 0, 0};  // negative indices count back from these
+  const char* const kinds[3] = {"vertex", "texture coordinate", "normal"};
+  const char* const plurals[3] = {"vertices", "texture coordinates", "normals"};
+  line_number = 0;
+  bool continued = false;  // a line ending in '\' continues the element on the next
+  std::string command;
+  while (std::getline(in, line)) {
+    ++line_number;
+    line = line.substr(0, line.find('\0'));
+    auto w = words(line);
+    if (!continued) {
+      if (w.empty()) continue;
+      command = w[0];
+      w.erase(w.begin());
+      if (command == "v") ++so_far[0];
+      if (command == "vt") ++so_far[1];
+      if (command == "vn") ++so_far[2];
+      if (command != "f" && command != "l" && command != "p") continue;
+    }
+    continued = !w.empty() && w.back() == "\\";
+    if (continued) w.pop_back();
+    for (const std::string& word : w) {
+      auto fail = [&](const std::string& expected) {
+        return InputError("mesh file " + quoted(path) + ", line " + std::to_string(line_number) + ": expected " +
+                          expected + " in '" + command + "', found '" + word.substr(0, 40) + "'");
+      };
+      // v, v/t, v//n or v/t/n; 'p' takes v only and 'l' v or v/t.
+      std::vector<std::string> parts;
+      std::size_t start = 0;
+      for (std::size_t slash; (slash = word.find('/', start)) != std::string::npos; start = slash + 1)
+        parts.push_back(word.substr(start, slash - start));
+      parts.push_back(word.substr(start));
+      const std::size_t max_parts = command == "f" ? 3 : command == "l" ? 2 : 1;
+      if (parts.size() > max_parts || parts[0].empty() || (parts.size() == 2 && parts[1].empty()) ||
+          (parts.size() == 3 && parts[2].empty()))
+        throw fail(command == "f" ? "indices v, v/t, v//n or v/t/n" : command == "l" ? "indices v or v/t" : "indices v");
+      for (std::size_t k = 0; k < parts.size(); ++k) {
+        if (parts[k].empty()) continue;  // the t of v//n
+        const std::string& text = parts[k];
+        const std::size_t digits = text.find_first_not_of("+-") == 1 ? text.size() - 1 : text.size();
+        if (digits == 0 || digits > 9 || text.find_first_not_of("0123456789", text.size() - digits) != std::string::npos)
+          throw fail("integer indices of at most 9 digits");
+        const long index = std::stol(text);
+        const bool known = index > 0 ? index <= total[k] : index < 0 && -index <= so_far[k];
+        if (!known)
+          throw fail("a " + std::string(kinds[k]) + " index within the file's " + std::to_string(total[k]) + " " +
+                     (total[k] == 1 ? kinds[k] : plurals[k]) + " (1-based, or negative counting back from the " +
+                     std::to_string(so_far[k]) + " read so far)");
+      }
+    }
+  }
+}
+
 vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkCommand* errors) {
   const std::string ext = lowercase(path.extension().string());
   if (ext == ".stl") {
@@ -75,6 +175,7 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
     return reader;
   }
   if (ext == ".obj") {
+    checkObjReferences(path);
     auto reader = vtkSmartPointer<vtkOBJReader>::New();
     reader->SetFileName(path.c_str());
     return reader;

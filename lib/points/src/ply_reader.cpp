@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -137,6 +138,9 @@ Header readHeader(std::istream& in, const std::filesystem::path& path) {
         const auto count_type = plyType(w[2]);
         const auto item_type = plyType(w[3]);
         if (!count_type || !item_type) throw fail("PLY scalar types in 'property list'", "'" + line + "'");
+        // A list length is a count: a float type would let 1e31 or NaN through as one.
+        if (*count_type == PlyType::Float32 || *count_type == PlyType::Float64)
+          throw fail("an integer type for the list length in 'property list'", "'" + w[2] + "'");
         p = {w[4], *item_type, true, *count_type};
       } else if (w.size() == 3) {
         const auto type = plyType(w[1]);
@@ -278,7 +282,8 @@ std::vector<double> parseAsciiRecord(const std::string& line, const Element& ele
       continue;
     }
     const double count = next("a list length for property '" + p.name + "'");
-    if (count < 0 || count > 1e9 || count != static_cast<double>(static_cast<long>(count)))
+    // Negated so that NaN fails too, before any conversion to an integer.
+    if (!(count >= 0 && count <= 1e9) || count != std::floor(count))
       throw fail("a non-negative integer list length", std::to_string(count));
     for (long j = 0; j < static_cast<long>(count); ++j)
       next("item " + std::to_string(j) + " of list '" + p.name + "'");
@@ -355,6 +360,9 @@ PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex
   std::vector<double> values;
   for (std::size_t e = 0; e <= vertex_index; ++e) {
     const Element& element = header.elements[e];
+    // Records without properties take no bytes: nothing to skip, and a declared
+    // count of 10^19 of them must not be counted through one by one.
+    if (element.properties.empty()) continue;
     for (std::size_t r = 0; r < element.count; ++r) {
       auto take = [&](PlyType type) {
         const auto value = cursor.read(type);

@@ -3,6 +3,10 @@
 // with "model", "center_mm", "radii_mm", "rotation_deg" [phi, theta, psi],
 // "rotation_matrix", "exponents", "cx", "cy", objective values and the
 // optimiser's report; plus top-level "best_model".
+#include <filesystem>
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "articula/fit/fit_hierarchy.hpp"
@@ -15,6 +19,11 @@ nlohmann::json modelFitJson(const ModelFit& fit);
 /// The shape of one fits.json "models" entry; throws InputError naming the
 /// missing or malformed key and `where` (e.g. the file name and index).
 geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where);
+
+/// Reads the JSON document of a fits.json file; throws InputError prefixed
+/// with `what` (the option that named the file, e.g. "--fits") when the file
+/// cannot be opened or is not valid JSON.
+nlohmann::json readFitsJson(const std::filesystem::path& path, const std::string& what);
 
 /// Every shape of a fits.json document, in file order.
 std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where);
