@@ -13,6 +13,8 @@ PACKAGES=(
   libsimbody-dev libfcl-dev libccd-dev libbullet-dev
   # studies that outgrow one machine (pipelines/Snakefile)
   snakemake
+  # fuzzing the readers (scripts/fuzz.sh): Clang and its libFuzzer runtime
+  clang libclang-rt-14-dev
 )
 
 missing=()
