@@ -136,22 +136,22 @@ expect_rc 2 "$A" nosuch --help
 grep -q "unknown command 'nosuch'" "$tmp/err" || fail "nosuch --help: $(cat "$tmp/err")"
 # Manifest columns the batch sets itself, or that no stage has: refused by
 # --validate and by the batch before any subject runs.
-printf 'subject,input,joint,side,until\ns1,4d.nii,hip,left,sample\n' > "$tmp/until.csv"
-expect_rc 3 "$A" batch "$tmp/until.csv" -o "$tmp/study-until"
-grep -q "column 'until': --until is set by the batch" "$tmp/err" || fail "until column: $(cat "$tmp/err")"
-[ ! -e "$tmp/study-until" ] || fail "batch made a study folder for a bad manifest"
-printf 'subject,input,joint,side,output\ns1,4d.nii,hip,left,elsewhere\n' > "$tmp/output.csv"
-expect_rc 3 "$A" batch "$tmp/output.csv" -o "$tmp/study-output" --validate
-grep -q "column 'output'" "$tmp/err" || fail "output column: $(cat "$tmp/err")"
-printf 'subject,input,joint,side,smoothnes\ns1,4d.nii,hip,left,0.5\n' > "$tmp/typo.csv"
-expect_rc 3 "$A" batch "$tmp/typo.csv" -o "$tmp/study-typo" --validate
-grep -q "typo.csv:2: subject s1: its options do not parse.*smoothnes" "$tmp/err" || fail "unknown column: $(cat "$tmp/err")"
-printf '\xef\xbb\xbfid,input,joint,side\ns1,4d.nii,hip,left\n' > "$tmp/bom.csv"
-expect_rc 3 "$A" batch "$tmp/bom.csv" -o "$tmp/study-bom" --validate
-grep -q "found 'id,input,joint,side'" "$tmp/err" || fail "BOM shown in the message: $(cat "$tmp/err")"
-printf 'subject,input,joint,side\n..,4d.nii,hip,left\n' > "$tmp/dots.csv"
-expect_rc 3 "$A" batch "$tmp/dots.csv" -o "$tmp/study-dots" --validate
-grep -q "not starting with '.'" "$tmp/err" || fail "subject '..': $(cat "$tmp/err")"
+# refused_manifest NAME TEXT PATTERN [batch options...]: the batch exits 3
+# naming the problem, and makes no study folder.
+refused_manifest() {
+  local name=$1 text=$2 pattern=$3; shift 3
+  printf "$text" > "$tmp/$name.csv"
+  expect_rc 3 "$A" batch "$tmp/$name.csv" -o "$tmp/study-$name" "$@"
+  grep -q -- "$pattern" "$tmp/err" || fail "manifest $name: $(cat "$tmp/err")"
+  [ ! -e "$tmp/study-$name" ] || fail "batch made a study folder for manifest $name"
+}
+refused_manifest until 'subject,input,joint,side,until\ns1,4d.nii,hip,left,sample\n' \
+  "column 'until': --until is set by the batch"
+refused_manifest output 'subject,input,joint,side,output\ns1,4d.nii,hip,left,elsewhere\n' "column 'output'" --validate
+refused_manifest typo 'subject,input,joint,side,smoothnes\ns1,4d.nii,hip,left,0.5\n' \
+  "typo.csv:2: subject s1: its options do not parse.*smoothnes" --validate
+refused_manifest bom '\xef\xbb\xbfid,input,joint,side\ns1,4d.nii,hip,left\n' "found 'id,input,joint,side'" --validate
+refused_manifest dots 'subject,input,joint,side\n..,4d.nii,hip,left\n' "not starting with '.'" --validate
 
 # A NIfTI cut short (half its voxels), plain and re-gzipped: refused, not zero-filled.
 nifti "$tmp/whole.nii" 16,16,16 1,1,1
