@@ -7,6 +7,7 @@
 #include <cstring>
 #include <set>
 #include <sstream>
+#include <vector>
 #include <unistd.h>
 
 #include <gdcmUIDGenerator.h>
@@ -125,6 +126,18 @@ void checkNiftiFile(const fs::path& path) {
                          "; expected a non-zero, finite size in mm");
       }
     }
+    // ITK builds the orientation from pixdim[0] (qfac), the quaternion, its
+    // offsets and the sform rows, and aborts the process (vnl's
+    // assert_finite) on a NaN or an infinity among them.
+    const int width = v1 ? 4 : 8;
+    std::vector<int> orientation_bytes = {v1 ? 76 : 104};
+    for (int k = 0; k < 18; ++k) orientation_bytes.push_back((v1 ? 256 : 352) + width * k);
+    for (int at : orientation_bytes)
+      if (!std::isfinite(real(at))) {
+        gzclose(file);
+        throw InputError(path.string() + ": the NIfTI header's orientation (pixdim[0], quatern, qoffset, srow) holds " +
+                         std::to_string(real(at)) + " at byte " + std::to_string(at) + "; expected finite numbers");
+      }
     // A .nii file must hold all its voxels: ITK allocates the whole image from
     // the header before it reads any voxel (a header of 10^9 voxels in a file
     // of a few bytes asked for gigabytes), and it reads a truncated file (or a
