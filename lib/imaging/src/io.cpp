@@ -119,24 +119,26 @@ void checkNiftiFile(const fs::path& path) {
     };
     for (int axis = 1; axis <= 3; ++axis) {
       const double spacing = real((v1 ? 76 : 104) + (v1 ? 4 : 8) * axis);
-      if (!(std::isfinite(spacing) && spacing != 0)) {
+      if (!(std::isfinite(spacing) && spacing != 0 && std::fabs(spacing) <= 1e4)) {
         gzclose(file);
         throw InputError(path.string() + ": the NIfTI header's pixdim[" + std::to_string(axis) +
                          "] (voxel size along axis " + std::to_string(axis) + ") is " + std::to_string(spacing) +
-                         "; expected a non-zero, finite size in mm");
+                         "; expected a non-zero size of at most 1e4 mm");
       }
     }
     // ITK builds the orientation from pixdim[0] (qfac), the quaternion, its
-    // offsets and the sform rows, and aborts the process (vnl's
-    // assert_finite) on a NaN or an infinity among them.
+    // offsets and the sform rows: it aborts the process (vnl's assert_finite)
+    // on a NaN or an infinity among them, and its SVD never ends on values
+    // near the float range. A kilometre bounds any real offset or sform entry.
     const int width = v1 ? 4 : 8;
     std::vector<int> orientation_bytes = {v1 ? 76 : 104};
     for (int k = 0; k < 18; ++k) orientation_bytes.push_back((v1 ? 256 : 352) + width * k);
     for (int at : orientation_bytes)
-      if (!std::isfinite(real(at))) {
+      if (!(std::fabs(real(at)) <= 1e6)) {
         gzclose(file);
         throw InputError(path.string() + ": the NIfTI header's orientation (pixdim[0], quatern, qoffset, srow) holds " +
-                         std::to_string(real(at)) + " at byte " + std::to_string(at) + "; expected finite numbers");
+                         std::to_string(real(at)) + " at byte " + std::to_string(at) +
+                         "; expected finite numbers of at most 1e6 in size");
       }
     // A .nii file must hold all its voxels: ITK allocates the whole image from
     // the header before it reads any voxel (a header of 10^9 voxels in a file
