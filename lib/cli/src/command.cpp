@@ -25,7 +25,7 @@ void addCommonOptions(CLI::App& app, CommonOptions& common) {
   app.add_option("--seed", common.seed, "Seed of every random choice (same seed, same output)")
       ->capture_default_str();
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   app.add_flag("--json", common.json, "Print a machine-readable summary on stdout");
   app.add_flag("--force", common.force, "Overwrite existing outputs");
