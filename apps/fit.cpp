@@ -99,6 +99,10 @@ class FitCommand : public cli::Command {
     app.add_option("--local-algorithm", local_algorithm_, "Local method: LM (Levenberg-Marquardt on the residuals) or NLopt's LD_SLSQP, LN_BOBYQA, LD_LBFGS, LD_MMA")
         ->capture_default_str();
     app.add_option("--max-evaluations", max_evaluations_, "Evaluation cap per local run")->capture_default_str();
+    app.add_option("--sample-points", sample_points_,
+                   "More points than this: fit on a seeded random sample of this many, then finish on all (0 = always all)")
+        ->check(CLI::Range(0, 100000000))
+        ->capture_default_str();
     app.add_option("--bounds", bounds_file_, "JSON of parameter bounds overrides, e.g. {\"gamma1\": [2, 3]}");
   }
 
@@ -110,6 +114,7 @@ class FitCommand : public cli::Command {
     o.strategy = fit::strategyFromName(strategy_);
     o.local_algorithm = local_algorithm_;
     o.max_evaluations = max_evaluations_;
+    o.sample_points = sample_points_;
     o.seed = static_cast<unsigned>(common.seed);
     if (!bounds_file_.empty()) o.bounds = readBounds(bounds_file_);
     o.validate();
@@ -131,7 +136,7 @@ class FitCommand : public cli::Command {
     for (const auto& f : summary.fits) models.push_back(fit::modelFitJson(f));
     nlohmann::json params = {{"models", models_},           {"objective", objective_},
                              {"strategy", strategy_},       {"local_algorithm", local_algorithm_},
-                             {"max_evaluations", max_evaluations_}, {"bounds", nlohmann::json(o.bounds)}};
+                             {"max_evaluations", max_evaluations_}, {"sample_points", sample_points_}, {"bounds", nlohmann::json(o.bounds)}};
     nlohmann::json doc = {{"coordinate_system", "LPS"},
                           {"units", "mm"},
                           {"input", input_.string()},
@@ -155,6 +160,7 @@ class FitCommand : public cli::Command {
   std::vector<std::string> models_ = {"sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid"};
   std::string objective_ = "geometric", strategy_ = "local", local_algorithm_ = fit::Options{}.local_algorithm;
   int max_evaluations_ = fit::Options{}.max_evaluations;
+  int sample_points_ = fit::Options{}.sample_points;
 };
 
 ARTICULA_REGISTER_COMMAND(FitCommand)

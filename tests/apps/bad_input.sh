@@ -149,6 +149,8 @@ expect_rc 2 "$A" sample -i "$tmp/head.csv" -o "$tmp/s.ply" --band 1e300
 [ ! -e "$tmp/r.nii.gz" ] && [ ! -e "$tmp/s.ply" ] || fail "an output was written for an option out of range"
 expect_rc 2 "$A" fit -i "$tmp/head.csv" -o "$tmp/t.json" --threads 100000
 [ ! -e "$tmp/t.json" ] || fail "fit ran with 100000 threads asked"
+expect_rc 2 "$A" fit -i "$tmp/head.csv" -o "$tmp/t.json" --sample-points 500
+grep -q "sample_points: expected 0 (all) or >= 1000" "$tmp/err" || fail "sample-points: $(cat "$tmp/err")"
 expect_rc 2 "$A" nosuch --help
 grep -q "unknown command 'nosuch'" "$tmp/err" || fail "nosuch --help: $(cat "$tmp/err")"
 # Manifest columns the batch sets itself, or that no stage has: refused by
