@@ -12,8 +12,9 @@ input=$1 out=$2 joint=${3:-hip} side=${4:-right}
 bin=${ARTICULA_BIN:-$(cd "$(dirname "$0")/.." && pwd)/build/bin}
 mkdir -p "$out"
 "$bin/articula-segment" -i "$input" -o "$out/label.nii.gz" --joint "$joint" --side "$side" --force
-"$bin/articula-mesh"    -i "$out/label.nii.gz" -o "$out/bone.vtp" --force
+"$bin/articula-mesh"    -i "$out/label.nii.gz" -o "$out/bone.vtp" --ct "$input" --force
 "$bin/articula-sample"  -i "$out/bone.vtp" -o "$out/points.ply" --force
 "$bin/articula-fit"     -i "$out/points.ply" -o "$out/fits.json" --force
 "$bin/articula-errors"  -i "$out/points.ply" --fits "$out/fits.json" -o "$out/errors" --force
-echo "done: $out/fits.json, $out/errors/summary.csv"
+"$bin/articula-report"  -i "$out" --ct "$input" --joint "$joint" --side "$side" --force
+echo "done: $out/results.json"

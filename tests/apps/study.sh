@@ -82,7 +82,18 @@ echo "batch: first run ${first}s, rerun ${second}s"
 
 # Snakemake, local profile, on the good subjects: the same study.csv.
 if command -v snakemake > /dev/null; then
-  grep -v -e missing -e baddicom "$tmp/study.csv" > "$tmp/good.csv"
+  # Stage options as manifest columns (the sample's and the report's): both
+  # runners must pass them on, from the one stage table.
+  grep -v -e missing -e baddicom "$tmp/study.csv" | sed -e '1s/$/,ball_radius,selection_floor/' -e '2,$s/$/,1.2,1.0/' \
+    > "$tmp/good.csv"
+  # An out-of-range stage option is refused by --validate, naming the stage.
+  sed -e '2s/,1.0$/,5/' "$tmp/good.csv" > "$tmp/bad-option.csv"
+  set +e
+  "$bin/articula" batch "$tmp/bad-option.csv" -o "$tmp/bad-option" --validate 2> "$tmp/bad-option.err"
+  rc=$?
+  set -e
+  [ "$rc" -eq 3 ] || { cat "$tmp/bad-option.err" >&2; fail "--validate with --selection-floor 5 exited $rc, expected 3"; }
+  grep -q "the report stage: --selection-floor" "$tmp/bad-option.err" || fail "validate names the stage: $(cat "$tmp/bad-option.err")"
   "$bin/articula" batch "$tmp/good.csv" -o "$tmp/batch-good" -j 2 --quiet
   snakemake -s "$src/pipelines/Snakefile" --profile "$src/pipelines/profiles/local" --quiet \
     --config manifest="$tmp/good.csv" study="$tmp/snake" bin="$bin" > "$tmp/snake.log" 2>&1 ||
@@ -92,8 +103,18 @@ if command -v snakemake > /dev/null; then
   [ "$(grep -c '<g class="subject">' "$tmp/snake/study.svg")" -eq 2 ] || fail "snakemake study.svg"
   [ -s "$tmp/snake/subjects/p1/errors/error_map.svg" ] || fail "snakemake error_map.svg"
   # Same seed, same outputs (batch-good vs the first batch, subject p2).
-  cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-good/subjects/p2/points.ply" || fail "same seed, different points"
-  cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-good/subjects/p2/results.csv" || fail "same seed, different fits"
+  # The columns took effect: a 1 mm floor selects the sphere, and a wider
+  # open ball keeps fewer points than the first batch's default.
+  for subject in p1 p2; do
+    grep -q '"selected_model": "sphere"' "$tmp/snake/subjects/$subject/results.json" || fail "snakemake: selection_floor ignored"
+    [ "$(wc -c < "$tmp/snake/subjects/$subject/points.ply")" -lt "$(wc -c < "$tmp/study/subjects/$subject/points.ply")" ] ||
+      fail "snakemake: ball_radius ignored"
+  done
+  # Same seed, same outputs (the two batches and Snakemake, subject p2, fit by fit).
+  "$bin/articula" batch "$tmp/study.csv" -o "$tmp/batch-again" -j 2 --quiet 2> /dev/null || true
+  cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-again/subjects/p2/points.ply" || fail "same seed, different points"
+  cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-again/subjects/p2/results.csv" || fail "same seed, different fits"
+  cmp "$tmp/batch-good/subjects/p2/results.csv" "$tmp/snake/subjects/p2/results.csv" || fail "snakemake and batch, different fits"
 else
   echo "snakemake not installed: Snakemake comparison skipped" >&2
 fi

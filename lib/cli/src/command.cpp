@@ -179,7 +179,7 @@ std::string argumentProblem(const std::string& name, const std::vector<std::stri
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? "asks for help or the version and would run nothing" : e.what();
   }
-  return "";
+  return command->argumentsProblem(common);
 }
 
 void printJson(const nlohmann::json& summary) { std::cout << summary.dump(2) << std::endl; }

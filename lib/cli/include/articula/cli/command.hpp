@@ -38,6 +38,10 @@ class Command {
   virtual void declare(CLI::App& app) = 0;
   /// Does the work; returns an exit code. Throws articula::Error subclasses.
   virtual int run(const CommonOptions& common) = 0;
+  /// What is wrong with the parsed arguments beyond the parser's own checks
+  /// (empty: nothing); argumentProblem() asks it, so that a caller can refuse
+  /// a command line before any work.
+  virtual std::string argumentsProblem(const CommonOptions&) const { return ""; }
 };
 
 /// Registry of commands (PDAL-style): each apps/<name>.cpp registers its

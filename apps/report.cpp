@@ -1,0 +1,59 @@
+// `articula-report -i SUBJECT_DIR`: the report stage. results.json,
+// results.csv and head.mrk.json from the folder's stage outputs (fits.json,
+// errors/summary.json, points.ply, label.nii.gz.json); exit 1 when the head's
+// checks fail (the files are still written, with the reasons in "qc").
+#include "articula/cli/command.hpp"
+#include "articula/core/error.hpp"
+#include "articula/core/log.hpp"
+#include "articula/pipeline/subject_report.hpp"
+
+namespace articula::apps {
+namespace {
+
+class ReportCommand : public cli::Command {
+ public:
+  std::string name() const override { return "report"; }
+  std::string description() const override {
+    return "Write a subject's results, selected model and head checks from its stage outputs";
+  }
+  std::string example() const override { return "articula-report -i out/subject01 --ct ct/ --joint hip --side right"; }
+  void declare(CLI::App& app) override {
+    app.add_option("-i,--input", options_.folder, "Subject folder holding fits.json, errors/summary.json and points.ply")
+        ->required();
+    app.add_option("--ct", options_.ct, "The subject's CT (recorded in results.json; hashed when it is a file)");
+    app.add_option("--joint", options_.joint, "hip or shoulder (recorded)")
+        ->check(CLI::IsMember({"hip", "shoulder"}))
+        ->capture_default_str();
+    app.add_option("--side", options_.side, "right or left (recorded)")
+        ->check(CLI::IsMember({"right", "left"}))
+        ->capture_default_str();
+    app.add_option("--selection-floor", options_.selection_floor_mm,
+                   "RMS differences up to this many mm never tell models apart (systematic error of the CT surface)")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    app.add_option("--selection-tolerance", options_.selection_tolerance,
+                   "The selected model is the simplest whose RMS is within this fraction of the least RMS")
+        ->check(CLI::Range(0.0, 10.0))
+        ->capture_default_str();
+  }
+  int run(const cli::CommonOptions& common) override {
+    if (!std::filesystem::is_directory(options_.folder))
+      throw InputError("--input: expected a subject folder, found '" + options_.folder.string() + "'");
+    if (!common.force && std::filesystem::exists(options_.folder / "results.json"))
+      throw UsageError("refusing to overwrite " + (options_.folder / "results.json").string() + " (use --force)");
+    options_.seed = common.seed;
+    const pipeline::QcReport qc = pipeline::writeSubjectReport(options_);
+    for (const std::string& reason : qc.reasons()) log::warn("qc " + reason);
+    if (qc.status == "fail")
+      throw ProcessingError("the result is not a plausible joint head (results.json, \"qc\"): " + qc.reasons().front());
+    return 0;
+  }
+
+ private:
+  pipeline::SubjectReportOptions options_;
+};
+
+ARTICULA_REGISTER_COMMAND(ReportCommand)
+
+}  // namespace
+}  // namespace articula::apps

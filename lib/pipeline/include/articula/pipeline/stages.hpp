@@ -1,0 +1,35 @@
+#pragma once
+// The pipeline's stages in run order, in one table: what each stage reads
+// and writes in a subject's folder, and which options a user may give for it
+// through `articula run`, a batch manifest column or the Snakemake workflow.
+// `articula run` chains the stages from it, `articula stages --json` prints
+// it, and pipelines/Snakefile builds its per-stage options from that print.
+// Adding a stage: its command in apps/, one row here.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace articula::pipeline {
+
+struct StageDescription {
+  std::string name;                  // also the command: articula <name>, articula-<name>
+  std::string description;
+  std::vector<std::string> options;  // forwarded options, without "--" (manifest columns use '_' for '-')
+  std::vector<std::string> inputs;   // in the subject folder; "CT" is the subject's input
+  std::vector<std::string> outputs;  // in the subject folder
+};
+
+/// segment, mesh, sample, fit, errors, report.
+const std::vector<StageDescription>& stages();
+
+/// The named stage; throws UsageError naming the stages when there is none.
+const StageDescription& stageNamed(const std::string& name);
+
+/// The stage names joined by ", " (for help texts).
+std::string stageNames();
+
+/// {"stages": [{"name", "description", "options", "inputs", "outputs"}, ...]}
+nlohmann::json stagesJson();
+
+}  // namespace articula::pipeline

@@ -1,0 +1,206 @@
+#include "articula/pipeline/subject_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "articula/core/atomic_file.hpp"
+#include "articula/core/error.hpp"
+#include "articula/core/provenance.hpp"
+#include "articula/fit/fits_json.hpp"
+#include "articula/geometry/pose.hpp"
+#include "articula/geometry/shape.hpp"
+#include "articula/pipeline/csv.hpp"
+#include "articula/pipeline/markups.hpp"
+#include "articula/pipeline/statistics.hpp"
+#include "articula/points/point_io.hpp"
+
+namespace articula::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// Parameter names with units, for results and study tables (angles in degrees).
+std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
+  if (kind == geometry::ParameterKind::Angle) return name + "_deg";
+  const std::string unit = geometry::parameterUnit(kind);
+  return unit.empty() ? name : name + "_" + unit;
+}
+
+json readStageJson(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError("cannot read '" + path.string() + "': " + e.what());
+  }
+}
+
+// The checks of a head (pipeline/qc.hpp) on the articular points, their
+// fitted sphere and the segmentation's own head, where it searched.
+QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes) {
+  HeadQcInput in;
+  const points::PointCloud cloud = points::readPoints(folder / "points.ply");
+  in.points = cloud.positions;
+  in.normals = cloud.normals;
+  const auto sphere =
+      std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
+  if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");
+  in.sphere_center = sphere->center;
+  in.sphere_radius_mm = sphere->radii[0];
+  const fs::path segment_summary = folder / "label.nii.gz.json";
+  if (fs::exists(segment_summary)) {
+    const json seg = readStageJson(segment_summary);
+    try {
+      if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
+        const auto& sc = seg.at("head_center_mm");
+        in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());
+        in.search_radius_mm = seg.value("search_radius_mm", 0.0);
+      }
+    } catch (const json::exception& e) {
+      throw InputError("cannot read the segmentation summary '" + segment_summary.string() + "': " + e.what());
+    }
+  }
+  return checkHead(in);
+}
+
+}  // namespace
+
+QcReport writeSubjectReport(const SubjectReportOptions& o) {
+  const fs::path fits_path = o.folder / "fits.json", summary_path = o.folder / "errors" / "summary.json";
+  const json fits = readStageJson(fits_path), summary = readStageJson(summary_path);
+  std::map<std::string, json> errors_by_model;
+  try {
+    for (const auto& row : summary.at("models")) errors_by_model[row.at("model").get<std::string>()] = row;
+  } catch (const json::exception& e) {
+    throw InputError("cannot read the error summary '" + summary_path.string() + "': " + e.what());
+  }
+  const auto shapes = fit::shapesFromFitsJson(fits, fits_path.string());
+  const std::string best = fits.value("best_model", "");
+  json models = json::array();
+  std::vector<std::string> csv_header = {"model", "n_parameters", "aic", "bic", "best_by_rms"};
+  std::string csv_rows;
+  geometry::ShapeParameters best_shape = shapes.front();
+  for (size_t model_index = 0; model_index < shapes.size(); ++model_index) {
+    const geometry::ShapeParameters& shape = shapes[model_index];
+    const json& fit_entry = fits.at("models")[model_index];
+    const std::string name = geometry::modelName(shape.model);
+    if (name == best) best_shape = shape;
+    const auto names = geometry::parameterNames(shape.model);
+    const auto kinds = geometry::parameterKinds(shape.model);
+    const Eigen::VectorXd lambda = geometry::toVector(shape);
+    json parameters = json::object();
+    for (size_t i = 0; i < names.size(); ++i) {
+      double v = lambda[static_cast<Eigen::Index>(i)];
+      if (kinds[i] == geometry::ParameterKind::Angle) v *= 180.0 / M_PI;
+      parameters[withUnit(names[i], kinds[i])] = v;
+    }
+    json errors = errors_by_model.count(name) ? errors_by_model[name] : json::object();
+    errors.erase("model");
+    const int k = geometry::parameterCount(shape.model);
+    const int n = errors.value("n_points", 0);
+    const double sse = errors.value("sse_mm2", 0.0);
+    json entry = {{"model", name}, {"n_parameters", k}, {"parameters", parameters}, {"errors", errors}};
+    // Standard errors in the parameters' units (angles in degrees); null:
+    // not identifiable from these points (fits.json, fit/uncertainty.hpp).
+    if (fit_entry.contains("standard_errors_table_3_2")) {
+      json standard_errors = json::object();
+      const json& se = fit_entry.at("standard_errors_table_3_2");
+      for (size_t i = 0; i < names.size(); ++i) {
+        json v = se.value(names[i], json(nullptr));
+        if (v.is_number() && kinds[i] == geometry::ParameterKind::Angle) v = v.get<double>() * 180.0 / M_PI;
+        standard_errors[withUnit(names[i], kinds[i])] = v;
+      }
+      entry["standard_errors"] = standard_errors;
+      entry["not_identifiable"] = fit_entry.value("not_identifiable", json::array());
+    }
+    if (n > k && sse > 0) {
+      entry["aic"] = aic(sse, n, k);
+      entry["bic"] = bic(sse, n, k);
+    }
+    models.push_back(entry);
+  }
+  // The model these points support (see selectParsimonious).
+  std::vector<ModelScore> scores;
+  for (const auto& m : models) scores.push_back({m.at("model"), m.at("n_parameters"), m.at("errors").value("rms_mm", NAN)});
+  const ModelSelection selection = selectParsimonious(scores, o.selection_tolerance, o.selection_floor_mm);
+  csv_header.push_back("selected");
+  // results.csv: one row per model, units in the column names.
+  std::vector<std::string> error_columns, parameter_columns;
+  for (const auto& m : models) {
+    for (const auto& [key, v] : m.at("errors").items())
+      if (std::find(error_columns.begin(), error_columns.end(), key) == error_columns.end()) error_columns.push_back(key);
+    for (const auto& [key, v] : m.at("parameters").items())
+      if (std::find(parameter_columns.begin(), parameter_columns.end(), key) == parameter_columns.end())
+        parameter_columns.push_back(key);
+  }
+  csv_header.insert(csv_header.end(), error_columns.begin(), error_columns.end());
+  csv_header.insert(csv_header.end(), parameter_columns.begin(), parameter_columns.end());
+  for (const auto& m : models) {
+    std::vector<std::string> f = {m.at("model"), std::to_string(m.at("n_parameters").get<int>()),
+                                  m.contains("aic") ? number(m.at("aic")) : "", m.contains("bic") ? number(m.at("bic")) : "",
+                                  m.at("model") == best ? "1" : "0", m.at("model") == selection.selected ? "1" : "0"};
+    for (const auto& c : error_columns) f.push_back(m.at("errors").contains(c) ? number(m.at("errors").at(c).get<double>()) : "");
+    for (const auto& c : parameter_columns)
+      f.push_back(m.at("parameters").contains(c) ? number(m.at("parameters").at(c).get<double>()) : "");
+    csv_rows += csvLine(f) + "\n";
+  }
+  // The head centre and axes of the best model, for 3D Slicer.
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(best_shape.angles);
+  const Eigen::Vector3d c = best_shape.center;
+  std::vector<LandmarkLine> axes;
+  const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
+  for (int i = 0; i < 3; ++i)
+    axes.push_back({axis_names[i], c - best_shape.radii[i] * R.col(i), c + best_shape.radii[i] * R.col(i)});
+  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
+
+  const QcReport qc = checkSubjectHead(o.folder, shapes);
+
+  Provenance provenance;
+  provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
+  provenance.inputs.erase(std::remove(provenance.inputs.begin(), provenance.inputs.end(), fs::path()), provenance.inputs.end());
+  provenance.seed = o.seed;
+  provenance.parameters = {{"joint", o.joint},
+                           {"side", o.side},
+                           {"input", o.ct.string()},
+                           {"selection_tolerance", o.selection_tolerance},
+                           {"selection_floor_mm", o.selection_floor_mm}};
+  const json results = {
+      {"input", o.ct.string()},
+      {"joint", o.joint},
+      {"side", o.side},
+      {"best_model", best},
+      {"selected_model", selection.selected},
+      {"selection",
+       {{"rule",
+         "the simplest model whose RMS exceeds the least RMS by at most the larger of relative_tolerance x the least RMS "
+         "and absolute_tolerance_mm"},
+        {"relative_tolerance", o.selection_tolerance},
+        {"absolute_tolerance_mm", o.selection_floor_mm},
+        {"indistinguishable", selection.indistinguishable}}},
+      {"head_center_mm", {c[0], c[1], c[2]}},
+      {"qc", qc.toJson()},
+      {"models", models},
+      {"coordinate_system", "LPS"},
+      {"units", "mm"},
+      {"provenance", provenanceJson(provenance)}};
+  writeFileAtomically(o.folder / "results.csv", csvLine(csv_header) + "\n" + csv_rows);
+  writeFileAtomically(o.folder / "results.json", results.dump(2) + "\n");
+  return qc;
+}
+
+}  // namespace articula::pipeline

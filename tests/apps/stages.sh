@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# The stage table: `articula stages --json` lists the stages in run order with
+# their options, inputs and outputs; every listed option is one of run's; the
+# report stage runs on its own (articula-report) as run runs it; a stage
+# option out of its range stops run before any stage.
+source "$(dirname "$0")/common.bash"
+
+expect_rc 0 "$bin/articula" stages --json
+cp "$tmp/out" "$tmp/stages.json"
+"$bin/articula" run --help > "$tmp/run-help.txt"
+python3 - "$tmp/stages.json" "$tmp/run-help.txt" <<'PY'
+import json, sys
+stages = json.load(open(sys.argv[1]))["stages"]
+names = [s["name"] for s in stages]
+assert names == ["segment", "mesh", "sample", "fit", "errors", "report"], names
+by = {s["name"]: s for s in stages}
+assert "series-uid" in by["segment"]["options"] and "series-uid" in by["mesh"]["options"]
+assert "smoothing" in by["mesh"]["options"], by["mesh"]
+assert by["report"]["options"] == ["selection-tolerance", "selection-floor"], by["report"]
+assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json"]
+assert "CT" in by["mesh"]["inputs"]
+help_text = open(sys.argv[2]).read()
+for s in stages:
+    for o in s["options"]:
+        assert f"--{o}" in help_text, f"run does not take --{o}"
+PY
+
+"$bin/articula" phantom -o "$tmp/p" --seed 5 --model sphere --no-dicom --quiet
+ct="$tmp/p/phantom.nii.gz"
+expect_rc 0 "$bin/articula" run -i "$ct" -o "$tmp/r" --quiet
+selected=$(python3 -c "import json; print(json.load(open('$tmp/r/results.json'))['selected_model'])")
+
+# The report stage alone: refuses to overwrite, then redoes run's report
+# (same numbers), and takes its options.
+expect_rc 2 "$bin/articula-report" -i "$tmp/r" --ct "$ct"
+grep -q "refusing to overwrite .*results.json" "$tmp/err" || fail "report overwrite message: $(cat "$tmp/err")"
+cp "$tmp/r/results.csv" "$tmp/run-results.csv"
+expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
+cmp "$tmp/r/results.csv" "$tmp/run-results.csv" || fail "articula-report and run's report differ"
+python3 - "$tmp/r/results.json" "$selected" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["selected_model"] == sys.argv[2], (r["selected_model"], sys.argv[2])
+assert "articula-report -i " in r["provenance"]["command"], r["provenance"]["command"]
+assert r["qc"]["status"] in ("pass", "warn"), r["qc"]
+PY
+expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force --selection-floor 1
+grep -q '"selected_model": "sphere"' "$tmp/r/results.json" || fail "--selection-floor 1 should select the sphere"
+
+# A missing stage output: exit 3, named; nothing written.
+mkdir -p "$tmp/r2/errors"
+cp "$tmp/r/points.ply" "$tmp/r2/"
+cp "$tmp/r/errors/summary.json" "$tmp/r2/errors/"
+expect_rc 3 "$bin/articula-report" -i "$tmp/r2" --ct "$ct"
+grep -q "needs '.*fits.json', which is missing" "$tmp/err" || fail "missing fits.json message: $(cat "$tmp/err")"
+[ ! -e "$tmp/r2/results.json" ] || fail "a results.json was written without fits"
+
+# A report option out of range stops run before its first stage.
+expect_rc 2 "$bin/articula" run -i "$ct" -o "$tmp/r3" --selection-floor 5
+grep -q "the report stage: --selection-floor" "$tmp/err" || fail "run names the stage: $(cat "$tmp/err")"
+[ ! -e "$tmp/r3/label.nii.gz" ] || fail "run segmented before refusing the option"
+echo "stages: ok"
