@@ -4,7 +4,10 @@
 // Prints one JSON line: n_points, rms_mm, mean_signed_mm (positive outside),
 // share_within_1p5_mm, max_abs_mm and, with RESULTS.json, centre_error_mm
 // (results' head_center_mm to the true centre). Used by bench/robustness.py.
+// ARTICULA_SCORE_POINTS=FILE also writes each point's x,y,z,signed distance
+// (mm) as CSV, to see where a head goes wrong.
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 
@@ -62,11 +65,17 @@ int main(int argc, char** argv) {
     const articula::distance::SignedDistance exact(hip.head);
     const articula::points::PointCloud cloud = articula::points::readPoints(argv[3]);
     const Eigen::Index n = cloud.positions.rows();
+    std::ofstream per_point;
+    if (const char* file = std::getenv("ARTICULA_SCORE_POINTS")) {
+      per_point.open(file);
+      per_point << "x,y,z,signed_mm\n";
+    }
     double sum = 0, sum2 = 0, max_abs = 0;
     long within = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Vector3d x = cloud.positions.row(i).transpose();
       const double d = articula::phantom::headSurfaceDistance(hip, exact.closest(x).distance, x);
+      if (per_point.is_open()) per_point << x.x() << ',' << x.y() << ',' << x.z() << ',' << d << '\n';
       sum += d;
       sum2 += d * d;
       max_abs = std::max(max_abs, std::fabs(d));
