@@ -1,1 +1,1 @@
-target_link_libraries(${test_name} PRIVATE articula_phantom articula_mesh articula_imaging)
+target_link_libraries(${test_name} PRIVATE articula_phantom articula_mesh articula_imaging articula_distance articula_geometry)

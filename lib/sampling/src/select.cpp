@@ -14,6 +14,9 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/distance/signed_distance.hpp"
+#include "articula/fit/algebraic_start.hpp"
+#include "articula/geometry/pose.hpp"
 #include "articula/geometry/sphere_fit.hpp"
 
 namespace articula::sampling {
@@ -48,6 +51,69 @@ std::vector<int> largestPatch(const std::vector<char>& chosen, const Eigen::Matr
   std::vector<int> out;
   for (size_t v = 0; v < chosen.size(); ++v)
     if (chosen[v] && findRoot(parent, static_cast<int>(v)) == best) out.push_back(static_cast<int>(v));
+  return out;
+}
+
+Eigen::MatrixX3d rowsOf(const Eigen::MatrixX3d& V, const std::vector<int>& rows) {
+  Eigen::MatrixX3d P(static_cast<Eigen::Index>(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(rows[i]);
+  return P;
+}
+
+/// The least-squares sphere of the selection's vertices and their RMS about it.
+void fitPatchSphere(const Eigen::MatrixX3d& V, Selection& patch) {
+  const Eigen::MatrixX3d P = rowsOf(V, patch.indices);
+  const geometry::Sphere sphere = geometry::fitSphere(P);
+  patch.sphere_center = sphere.center;
+  patch.sphere_radius = sphere.radius;
+  patch.sphere_rms_mm = std::sqrt(
+      ((P.rowwise() - patch.sphere_center.transpose()).rowwise().norm().array() - patch.sphere_radius).square().mean());
+}
+
+// Heads are not spheres (radii differ by up to about 10 %): a band around a
+// sphere wide enough to hold such a cap also holds the first millimetre of
+// the neck, the fovea's rim and the socket-side bulges of a coarse CT. The
+// last pass therefore bands the patch's own ellipsoid (ellipsoid-specific
+// algebraic fit, exact distances) at the surface's own scatter: three robust
+// standard deviations of the patch's distances, between kMinEllipsoidBandMm
+// and the sphere's band. The vertices' normals must still lie within the
+// tolerance of the ellipsoid's normal.
+constexpr double kMinEllipsoidBandMm = 0.4;
+
+/// The vertices within the patch's ellipsoid band, as the largest connected
+/// patch; `patch` unchanged when no ellipsoid fits it (degenerate or flat).
+std::vector<int> ellipsoidBand(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
+                               const std::vector<int>& patch, double band_mm, double cos_tol) {
+  geometry::ShapeParameters ellipsoid;
+  try {
+    ellipsoid = fit::algebraicEllipsoid(rowsOf(V, patch));
+  } catch (const Error&) {
+    return patch;
+  }
+  if (!(ellipsoid.radii.maxCoeff() < 4 * ellipsoid.radii.minCoeff())) return patch;  // not a head's shape
+  const distance::SignedDistance exact(ellipsoid);
+  std::vector<double> scatter;
+  scatter.reserve(patch.size());
+  for (int v : patch) scatter.push_back(std::fabs(exact.closest(V.row(v).transpose()).distance));
+  std::nth_element(scatter.begin(), scatter.begin() + static_cast<long>(scatter.size() / 2), scatter.end());
+  const double robust_sd = 1.4826 * scatter[scatter.size() / 2];
+  const double band = std::clamp(3.0 * robust_sd, kMinEllipsoidBandMm, band_mm);
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(ellipsoid.angles);
+  const Eigen::Vector3d inverse_square = ellipsoid.radii.cwiseProduct(ellipsoid.radii).cwiseInverse();
+  const double reach = ellipsoid.radii.maxCoeff() + band_mm;
+  std::vector<char> chosen(static_cast<size_t>(V.rows()), 0);
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v).transpose();
+    if ((x - ellipsoid.center).norm() > reach) continue;
+    const Eigen::Vector3d local = R.transpose() * (x - ellipsoid.center);
+    const Eigen::Vector3d normal = (R * local.cwiseProduct(inverse_square)).normalized();
+    chosen[static_cast<size_t>(v)] =
+        N.row(v).dot(normal) >= cos_tol && std::fabs(exact.closest(x).distance) <= band;
+  }
+  std::vector<int> out = largestPatch(chosen, F);
+  std::ostringstream m;
+  m << "ellipsoid band " << band << " mm: " << patch.size() << " -> " << out.size() << " vertices";
+  log::debug(m.str());
   return out;
 }
 
@@ -153,13 +219,14 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
         }
         patch.indices = largestPatch(chosen, F);
         if (static_cast<int>(patch.indices.size()) < std::max(o.min_points, 4)) break;
-        Eigen::MatrixX3d P(static_cast<Eigen::Index>(patch.indices.size()), 3);
-        for (size_t i = 0; i < patch.indices.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(patch.indices[i]);
-        const geometry::Sphere sphere = geometry::fitSphere(P);
-        patch.sphere_center = sphere.center;
-        patch.sphere_radius = sphere.radius;
-        patch.sphere_rms_mm = std::sqrt(
-            ((P.rowwise() - patch.sphere_center.transpose()).rowwise().norm().array() - patch.sphere_radius).square().mean());
+        fitPatchSphere(V, patch);
+      }
+      if (static_cast<int>(patch.indices.size()) >= std::max(o.min_points, 10)) {
+        std::vector<int> banded = ellipsoidBand(V, N, F, patch.indices, o.band_mm, cos_tol);
+        if (static_cast<int>(banded.size()) >= std::max(o.min_points, 10)) {
+          patch.indices = std::move(banded);
+          fitPatchSphere(V, patch);
+        }
       }
       return patch;
     };

@@ -3,7 +3,8 @@
 // step (section 3.2.2) made automatic: the head's spherical region found by
 // CGAL's Efficient RANSAC (spheres of plausible radius), then the vertices in
 // a band around that sphere whose normals point radially outwards, as the
-// largest connected patch of the mesh; or a region given by hand.
+// largest connected patch of the mesh, and last a band around that patch's
+// own ellipsoid (a head is not a sphere); or a region given by hand.
 #include <string>
 #include <vector>
 
