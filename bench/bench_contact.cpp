@@ -36,7 +36,7 @@
 
 #include "articula/contact/common_normal.hpp"
 #include "articula/contact/plane_contact.hpp"
-#include "articula/contact/reference.hpp"
+#include "articula/testsupport/contact_reference.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
-#include "articula/fit/synthetic_cap.hpp"
+#include "articula/testsupport/synthetic_cap.hpp"
 #include "articula/geometry/surface.hpp"
 
 namespace {

@@ -26,7 +26,7 @@
 
 #include "articula/core/parallel.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
-#include "articula/fit/synthetic_cap.hpp"
+#include "articula/testsupport/synthetic_cap.hpp"
 #include "articula/geometry/shape.hpp"
 
 namespace {

@@ -12,7 +12,7 @@
 #include "articula/contact/frame_derivatives.hpp"
 #include "articula/contact/plane_contact.hpp"
 #include "articula/contact/proximity.hpp"
-#include "articula/contact/reference.hpp"
+#include "articula/testsupport/contact_reference.hpp"
 #include "articula/contact/scenario.hpp"
 #include "articula/core/error.hpp"
 #include "articula/geometry/surfaces.hpp"

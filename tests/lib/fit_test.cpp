@@ -14,7 +14,7 @@
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/levenberg_marquardt.hpp"
 #include "articula/fit/parameter_gradient.hpp"
-#include "articula/fit/synthetic_cap.hpp"
+#include "articula/testsupport/synthetic_cap.hpp"
 #include "articula/geometry/surface.hpp"
 
 namespace {

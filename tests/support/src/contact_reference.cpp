@@ -1,4 +1,4 @@
-#include "articula/contact/reference.hpp"
+#include "articula/testsupport/contact_reference.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/QR>

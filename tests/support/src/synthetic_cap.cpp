@@ -1,4 +1,4 @@
-#include "articula/fit/synthetic_cap.hpp"
+#include "articula/testsupport/synthetic_cap.hpp"
 
 #include <cmath>
 #include <random>
