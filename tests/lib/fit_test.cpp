@@ -228,6 +228,28 @@ TEST(FitHierarchy, SmallCapFitsTheNoiseAndReportsRadiusSpread) {
             << " mm (truth 20 22 25)\n";
 }
 
+// Why each model stopped, as a type: converged runs on a noisy cap say
+// which test ended them; an evaluation limit that cuts the ellipsoid short
+// says so and is not converged, whatever the words say.
+TEST(FitHierarchy, TerminationTypeTellsConvergedRunsFromCutOnes) {
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Ellipsoid), 1.2, 600, 0.1, 8);
+  Options o;
+  o.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid};
+  for (const auto& f : articula::fit::fitHierarchy(pts, o).fits) {
+    EXPECT_TRUE(f.converged) << f.termination;
+    EXPECT_TRUE(articula::fit::isConverged(f.termination_type)) << articula::fit::terminationName(f.termination_type);
+  }
+  o.max_evaluations = 3;  // with no tolerance left to meet, only the limit ends a run
+  o.relative_tolerance = 0;
+  o.parameter_tolerance = 0;
+  o.restarts = 0;
+  const Summary cut_summary = articula::fit::fitHierarchy(pts, o);
+  const articula::fit::ModelFit& cut = cut_summary.fit(ShapeModel::Ellipsoid);
+  EXPECT_EQ(cut.termination_type, articula::fit::Termination::EvaluationLimit) << cut.termination;
+  EXPECT_FALSE(cut.converged);
+  EXPECT_STREQ(articula::fit::terminationName(cut.termination_type), "evaluation_limit");
+}
+
 TEST(FitHierarchy, DeterministicForAFixedSeed) {
   const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Superovoid), 1.0, 800, 0.1, 4);
   Options o;

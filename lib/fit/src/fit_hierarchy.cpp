@@ -303,6 +303,18 @@ class ObjectiveFunction {
   Eigen::MatrixX3d feet_, best_feet_;
 };
 
+Termination resultType(nlopt::result r) {
+  switch (r) {
+    case nlopt::SUCCESS:
+    case nlopt::FTOL_REACHED: return Termination::ObjectiveTolerance;
+    case nlopt::STOPVAL_REACHED: return Termination::ExactFit;
+    case nlopt::XTOL_REACHED: return Termination::ParameterTolerance;
+    case nlopt::MAXEVAL_REACHED: return Termination::EvaluationLimit;
+    case nlopt::MAXTIME_REACHED: return Termination::TimeLimit;
+    default: return Termination::OptimizerFailure;
+  }
+}
+
 std::string resultName(nlopt::result r) {
   switch (r) {
     case nlopt::SUCCESS: return "success";
@@ -321,6 +333,7 @@ struct RunResult {
   double value = 0.0;
   int evaluations = 0;
   std::string termination;
+  Termination type = Termination::InvalidStart;
   bool converged = false;
 };
 
@@ -350,14 +363,16 @@ RunResult runNlopt(nlopt::algorithm algorithm, ShapeModel model, const VectorXd&
   try {
     const nlopt::result r = opt.optimize(x, value);
     result.termination = resultName(r);
-    result.converged = r == nlopt::SUCCESS || r == nlopt::FTOL_REACHED || r == nlopt::XTOL_REACHED ||
-                       r == nlopt::STOPVAL_REACHED;
+    result.type = resultType(r);
+    result.converged = isConverged(result.type);
   } catch (const nlopt::roundoff_limited&) {
     // Reached the minimum to rounding: keep the best point.
     result.termination = "roundoff limited";
+    result.type = Termination::RoundoffLimited;
     result.converged = true;
   } catch (const std::exception& e) {
     result.termination = std::string("NLopt stopped: ") + e.what();
+    result.type = Termination::OptimizerFailure;
   }
   result.x = objective.best_lambda;
   result.feet = objective.bestFeet();
@@ -376,7 +391,7 @@ RunResult runLevenbergMarquardt(ShapeModel model, const VectorXd& start, const B
   lm.parameter_tolerance = o.parameter_tolerance;
   lm.absolute_cost = 1e-20 * static_cast<double>(points.rows());
   const LeastSquaresResult r = levenbergMarquardt(problem, start, bounds.lower, bounds.upper, lm);
-  return {r.x, problem.feet(), r.cost, r.evaluations, r.termination, r.converged};
+  return {r.x, problem.feet(), r.cost, r.evaluations, r.termination, r.type, r.converged};
 }
 
 // The local method of `o` from `start`: ours (LM) or NLopt's.
@@ -585,6 +600,7 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
       fitted.feet = run.feet;  // guesses for the exact distances below
       best.parameters = wrapAngles(releaseOvoidScales(geometry::fromVector(model, run.x), model_bounds));
       best.termination = how + o.local_algorithm + ": " + run.termination;
+      best.termination_type = run.type;
       best.converged = run.converged;
       best.started_from = start.label;
     }

@@ -73,6 +73,7 @@ nlohmann::json modelFitJson(const ModelFit& f) {
           {"seconds", f.seconds},
           {"started_from", f.started_from},
           {"termination", f.termination},
+          {"termination_type", terminationName(f.termination_type)},
           {"converged", f.converged}};
 }
 

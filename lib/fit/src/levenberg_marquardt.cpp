@@ -22,6 +22,7 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
   if (!problem.evaluate(result.x, r) || !r.allFinite()) {
     result.cost = std::numeric_limits<double>::infinity();
     result.termination = "invalid start";
+    result.type = Termination::InvalidStart;
     return result;
   }
   result.cost = r.squaredNorm();
@@ -33,11 +34,13 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
   for (;;) {
     if (result.cost <= o.absolute_cost) {
       result.termination = "residuals at rounding level";
+      result.type = Termination::ExactFit;
       result.converged = true;
       break;
     }
     if (result.evaluations >= o.max_evaluations) {
       result.termination = "evaluation limit reached";
+      result.type = Termination::EvaluationLimit;
       break;
     }
     // J^T J through its lower half (half the work of the full product).
@@ -89,6 +92,7 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
     const double scaled_x = result.x.cwiseProduct(scale.cwiseSqrt()).norm();
     if (!(scaled_step > o.parameter_tolerance * (scaled_x + o.parameter_tolerance))) {
       result.termination = "parameter tolerance reached";
+      result.type = Termination::ParameterTolerance;
       result.converged = true;
       break;
     }
@@ -109,6 +113,7 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
       nu = 2.0;
       if (gain <= o.relative_tolerance * (result.cost + gain)) {
         result.termination = "objective tolerance reached";
+        result.type = Termination::ObjectiveTolerance;
         result.converged = true;
         break;
       }
@@ -117,6 +122,7 @@ LeastSquaresResult levenbergMarquardt(LeastSquaresProblem& problem, const Vector
       nu *= 2.0;
       if (mu > 1e20) {
         result.termination = "no further descent (damping limit)";
+        result.type = Termination::NoFurtherDescent;
         result.converged = true;
         break;
       }

@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "articula/fit/termination.hpp"
 #include "articula/fit/uncertainty.hpp"
 #include "articula/geometry/shape.hpp"
 
@@ -81,7 +82,8 @@ struct ModelFit {
   double algebraic_objective = 0.0;  // eq. 3.1 at the result
   int evaluations = 0;
   double seconds = 0.0;
-  std::string termination;         // NLopt's reason, or why the parent was kept
+  std::string termination;         // the optimiser's reason in words, and whether the parent was kept
+  Termination termination_type = Termination::InvalidStart;  // the same for programs (of the run kept)
   bool converged = false;
   ParameterUncertainty uncertainty;  // at the result (uncertainty.hpp)
 };

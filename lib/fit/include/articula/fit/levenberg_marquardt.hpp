@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 
+#include "articula/fit/termination.hpp"
+
 namespace articula::fit {
 
 /// The residuals of a least-squares problem. `evaluate` is always followed
@@ -38,6 +40,7 @@ struct LeastSquaresResult {
   int evaluations = 0;
   int iterations = 0;  // accepted steps
   std::string termination;
+  Termination type = Termination::InvalidStart;
   bool converged = false;
 };
 
