@@ -26,6 +26,10 @@ set(NLopt_DIR /usr/lib/x86_64-linux-gnu/cmake/nlopt_cxx CACHE PATH "NLopt C++ co
 find_package(NLopt QUIET CONFIG)
 articula_require(NLopt_FOUND libnlopt-cxx-dev)
 
+# The multibody engine of lib/dynamics (and a measured contact peer).
+find_package(Simbody QUIET CONFIG)
+articula_require(Simbody_FOUND libsimbody-dev)
+
 find_package(ITK 5.2 QUIET)
 articula_require(ITK_FOUND libinsighttoolkit5-dev)
 
@@ -46,8 +50,6 @@ if(ARTICULA_BUILD_BENCH)
   find_package(benchmark QUIET CONFIG)
   articula_require(benchmark_FOUND libbenchmark-dev)
   # Measured peers for the contact benchmarks.
-  find_package(Simbody QUIET CONFIG)
-  articula_require(Simbody_FOUND libsimbody-dev)
   find_package(fcl QUIET CONFIG)
   articula_require(fcl_FOUND libfcl-dev)
   find_package(ccd QUIET CONFIG)

@@ -1,0 +1,59 @@
+#pragma once
+// Compliant contact on Simbody: a force element (Simbody's Force::Custom)
+// that evaluates articula's contact geometry for every registered pair at
+// each force evaluation and applies the force laws of contact/force_laws.hpp
+// at the contact points. Pairs: a convex shape (sphere, ellipsoid,
+// superellipsoid) on a body against a plane fixed in ground (the closed form
+// of thesis section 5.3), and a sphere inside a spherical cavity fixed in
+// ground (conformal contact, thesis section 5.2.7). SI units.
+#include <memory>
+
+#include <Simbody.h>
+
+#include "articula/contact/convex_shape.hpp"
+#include "articula/contact/force_laws.hpp"
+
+namespace articula::dynamics {
+
+struct ContactLaws {
+  contact::NormalForceLaw normal;
+  contact::FrictionLaw friction;
+};
+
+/// What the element did, for summaries and benchmarks.
+struct ContactCounters {
+  long long evaluations = 0;  // pair evaluations (one per pair per force evaluation)
+  long long in_contact = 0;   // of those, with positive depth
+};
+
+class CompliantContact {
+ public:
+  /// Adds the element to `forces` (Simbody owns it; this handle registers pairs).
+  explicit CompliantContact(SimTK::GeneralForceSubsystem& forces);
+  ~CompliantContact();
+  CompliantContact(const CompliantContact&) = delete;
+  CompliantContact& operator=(const CompliantContact&) = delete;
+
+  /// `shape` given in the body's frame (centre, rotation, radii, exponents)
+  /// against the plane through `plane_point` with outward normal
+  /// `plane_normal` (ground frame; the solid lies on the other side).
+  void addShapeOnPlane(const SimTK::MobilizedBody& body, const contact::ConvexShape& shape,
+                       const Eigen::Vector3d& plane_point, const Eigen::Vector3d& plane_normal, const ContactLaws& laws);
+
+  /// A ball of `radius` centred at the body's origin inside a spherical
+  /// cavity of `cavity_radius` centred at `cavity_center` (ground).
+  void addSphereInCavity(const SimTK::MobilizedBody& body, double radius, const Eigen::Vector3d& cavity_center,
+                         double cavity_radius, const ContactLaws& laws);
+
+  const ContactCounters& counters() const;
+
+  /// The contact forces of every pair at `state` (Stage::Velocity or later), in
+  /// registration order, for output.
+  std::vector<contact::ContactForce> forces(const SimTK::State& state) const;
+
+ private:
+  class Element;
+  Element* element_;  // owned by the force subsystem
+};
+
+}  // namespace articula::dynamics

@@ -1,0 +1,187 @@
+// Compliant contact on Simbody against closed forms and Simbody's own
+// contact: a ball settles on a plane at the Hertz depth; with no damping and
+// no friction a bouncing ball keeps its energy; a ball rolling without slip
+// at the bottom of a spherical bowl oscillates with the period of the rigid
+// rolling solution; a sphere dropped with spin on a plane follows Simbody's
+// HuntCrossleyForce with the same parameters.
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <Simbody.h>
+
+#include "articula/contact/convex_shape.hpp"
+#include "articula/dynamics/compliant_contact.hpp"
+
+namespace {
+
+using articula::contact::NormalLaw;
+using articula::dynamics::CompliantContact;
+using articula::dynamics::ContactLaws;
+using Eigen::Vector3d;
+
+constexpr double kGravity = 9.81;
+
+struct BallWorld {
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter{system};
+  SimTK::GeneralForceSubsystem forces{system};
+  SimTK::Force::Gravity gravity{forces, matter, -SimTK::ZAxis, kGravity};
+  SimTK::MobilizedBody::Free ball;
+  BallWorld(double mass, double inertia)
+      : ball(matter.Ground(), SimTK::Transform(),
+             SimTK::Body::Rigid(SimTK::MassProperties(mass, SimTK::Vec3(0), SimTK::UnitInertia(inertia / mass))),
+             SimTK::Transform()) {}
+};
+
+articula::contact::ConvexShape sphere(double r) {
+  return articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), Vector3d::Constant(r));
+}
+
+ContactLaws hertzLaws(double stiffness, NormalLaw law, double dissipation, double mu) {
+  ContactLaws laws;
+  laws.normal.law = law;
+  laws.normal.stiffness = stiffness;
+  laws.normal.dissipation = dissipation;
+  laws.friction.dynamic = mu;
+  laws.friction.transition_speed = 1e-3;
+  return laws;
+}
+
+TEST(Dynamics, ABallSettlesOnAPlaneAtTheHertzDepth) {
+  const double m = 1.0, r = 0.1, K = 1e7;
+  BallWorld w(m, 0.4 * m * r * r);
+  CompliantContact contact(w.forces);
+  contact.addShapeOnPlane(w.ball, sphere(r), Vector3d::Zero(), Vector3d::UnitZ(),
+                          hertzLaws(K, NormalLaw::HuntCrossley, 5.0, 0.0));
+  w.system.realizeTopology();
+  SimTK::State state = w.system.getDefaultState();
+  w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, r + 0.002));
+  SimTK::RungeKuttaMersonIntegrator integrator(w.system);
+  integrator.setAccuracy(1e-9);
+  SimTK::TimeStepper stepper(w.system, integrator);
+  stepper.initialize(state);
+  stepper.stepTo(3.0);
+  const double depth = r - w.ball.getBodyOriginLocation(integrator.getState())[2];
+  const double hertz = std::pow(m * kGravity / K, 2.0 / 3.0);
+  EXPECT_NEAR(depth, hertz, 1e-6 * hertz);
+  EXPECT_GT(contact.counters().in_contact, 0);
+}
+
+TEST(Dynamics, AnElasticBounceKeepsItsEnergy) {
+  const double m = 0.5, r = 0.05, K = 1e6;
+  BallWorld w(m, 0.4 * m * r * r);
+  CompliantContact contact(w.forces);
+  contact.addShapeOnPlane(w.ball, sphere(r), Vector3d::Zero(), Vector3d::UnitZ(),
+                          hertzLaws(K, NormalLaw::Hertz, 0.0, 0.0));
+  w.system.realizeTopology();
+  SimTK::State state = w.system.getDefaultState();
+  w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, r + 0.2));
+  w.ball.setUToFitLinearVelocity(state, SimTK::Vec3(0.3, 0, 0));
+  w.system.realize(state, SimTK::Stage::Dynamics);
+  const double e0 = w.system.calcEnergy(state);
+  SimTK::RungeKuttaMersonIntegrator integrator(w.system);
+  integrator.setAccuracy(1e-10);
+  SimTK::TimeStepper stepper(w.system, integrator);
+  stepper.initialize(state);
+  double worst = 0;
+  for (int i = 1; i <= 100; ++i) {
+    stepper.stepTo(0.1 * i);
+    const SimTK::State& s = integrator.getState();
+    w.system.realize(s, SimTK::Stage::Dynamics);
+    worst = std::max(worst, std::fabs(w.system.calcEnergy(s) - e0) / std::fabs(e0));
+  }
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_GT(contact.counters().in_contact, 100);  // it did bounce, several times
+}
+
+// A solid ball (I = 2/5 m r^2) rolling without slip at the bottom of a bowl
+// of radius R: small oscillations of period 2 pi sqrt(7 (R - r) / (5 g)).
+TEST(Dynamics, ABallRollingInABowlOscillatesWithTheRollingPeriod) {
+  const double m = 1.0, r = 0.1, R = 1.0, K = 1e7;
+  BallWorld w(m, 0.4 * m * r * r);
+  CompliantContact contact(w.forces);
+  ContactLaws laws = hertzLaws(K, NormalLaw::HuntCrossley, 0.1, 0.5);
+  laws.friction.transition_speed = 1e-3;
+  contact.addSphereInCavity(w.ball, r, Vector3d(0, 0, R), R, laws);
+  w.system.realizeTopology();
+  SimTK::State state = w.system.getDefaultState();
+  const double angle = 0.05;  // from the bottom, about the y axis
+  const double sag = std::pow(m * kGravity / K, 2.0 / 3.0);
+  const double arm = R - r + sag;
+  w.ball.setQToFitTranslation(state, SimTK::Vec3(arm * std::sin(angle), 0, R - arm * std::cos(angle)));
+  SimTK::RungeKuttaMersonIntegrator integrator(w.system);
+  integrator.setAccuracy(1e-8);
+  SimTK::TimeStepper stepper(w.system, integrator);
+  stepper.initialize(state);
+  // Crossings of x = 0 (linear interpolation between samples), half a period apart.
+  std::vector<double> crossings;
+  double t_prev = 0, x_prev = w.ball.getBodyOriginLocation(integrator.getState())[0];
+  const double dt = 1e-3;
+  for (int i = 1; i <= 4000 && crossings.size() < 3; ++i) {
+    stepper.stepTo(i * dt);
+    const double x = w.ball.getBodyOriginLocation(integrator.getState())[0];
+    if ((x_prev < 0) != (x < 0)) crossings.push_back(t_prev + dt * (-x_prev) / (x - x_prev));
+    t_prev = i * dt;
+    x_prev = x;
+  }
+  ASSERT_GE(crossings.size(), 3u);
+  const double period = 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  const double rolling = 2 * M_PI * std::sqrt(7.0 * (R - r) / (5.0 * kGravity));
+  EXPECT_NEAR(period, rolling, 0.005 * rolling) << "sliding: " << 2 * M_PI * std::sqrt((R - r) / kGravity) << " s";
+}
+
+// Simbody's HuntCrossleyForce with the same law: f = K d^1.5 (1 + 3/2 c d'),
+// K = 4/3 sqrt(R) E with E = (E1^(2/3) / 2)^(3/2) for two surfaces of plane
+// strain modulus E1, and its friction; a sphere dropped with spin and
+// forward speed rolls and slides.
+TEST(Dynamics, ASphereOnAPlaneFollowsSimbodysHuntCrossley) {
+  const double m = 1.0, r = 0.05, k_surface = 1e8, c = 0.5, mu_s = 0.6, mu_d = 0.4, vt = 0.01;
+  const auto simulate = [&](bool ours) {
+    BallWorld w(m, 0.4 * m * r * r);
+    SimTK::GeneralContactSubsystem contacts(w.system);
+    std::unique_ptr<CompliantContact> element;
+    if (ours) {
+      const double modulus = k_surface / std::pow(2.0, 1.5);
+      ContactLaws laws = hertzLaws(4.0 / 3.0 * std::sqrt(r) * modulus, NormalLaw::HuntCrossley, c, mu_d);
+      laws.friction.static_peak = mu_s;
+      laws.friction.transition_speed = vt;
+      element = std::make_unique<CompliantContact>(w.forces);
+      element->addShapeOnPlane(w.ball, sphere(r), Vector3d::Zero(), Vector3d::UnitZ(), laws);
+    } else {
+      const SimTK::ContactSetIndex set = contacts.createContactSet();
+      contacts.addBody(set, w.ball, SimTK::ContactGeometry::Sphere(r), SimTK::Transform());
+      contacts.addBody(set, w.matter.updGround(), SimTK::ContactGeometry::HalfSpace(),
+                       SimTK::Transform(SimTK::Rotation(0.5 * SimTK::Pi, SimTK::YAxis), SimTK::Vec3(0)));
+      SimTK::HuntCrossleyForce hc(w.forces, contacts, set);
+      hc.setBodyParameters(SimTK::ContactSurfaceIndex(0), k_surface, c, mu_s, mu_d, 0);
+      hc.setBodyParameters(SimTK::ContactSurfaceIndex(1), k_surface, c, mu_s, mu_d, 0);
+      hc.setTransitionVelocity(vt);
+    }
+    w.system.realizeTopology();
+    SimTK::State state = w.system.getDefaultState();
+    w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, r + 0.01));
+    w.ball.setUToFitVelocity(state, SimTK::SpatialVec(SimTK::Vec3(0, 20, 3), SimTK::Vec3(1.0, 0.2, 0)));
+    SimTK::RungeKuttaMersonIntegrator integrator(w.system);
+    integrator.setAccuracy(1e-10);
+    SimTK::TimeStepper stepper(w.system, integrator);
+    stepper.initialize(state);
+    std::vector<SimTK::Vec3> path;
+    for (int i = 1; i <= 50; ++i) {
+      stepper.stepTo(0.01 * i);
+      path.push_back(w.ball.getBodyOriginLocation(integrator.getState()));
+    }
+    return path;
+  };
+  const std::vector<SimTK::Vec3> ours = simulate(true), simbody = simulate(false);
+  double worst = 0, travelled = 0;
+  for (size_t i = 0; i < ours.size(); ++i) {
+    worst = std::max(worst, (ours[i] - simbody[i]).norm());
+    travelled = std::max(travelled, (simbody[i] - simbody[0]).norm());
+  }
+  EXPECT_LT(worst, 1e-6) << "travelled " << travelled << " m";
+  EXPECT_GT(travelled, 0.05);  // it rolled and slid, not just sat
+}
+
+}  // namespace
