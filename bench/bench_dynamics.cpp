@@ -13,6 +13,7 @@
 
 #include "articula/contact/convex_shape.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
+#include "articula/testsupport/ball_world.hpp"
 
 namespace {
 
@@ -20,7 +21,8 @@ using articula::dynamics::CompliantContact;
 using articula::dynamics::ContactLaws;
 using Eigen::Vector3d;
 
-constexpr double kGravity = 9.81;
+using articula::testsupport::BallWorld;
+using articula::testsupport::Simulation;
 
 struct Run {
   int steps = 0;
@@ -28,25 +30,14 @@ struct Run {
   long long contact_evaluations = 0;
 };
 
-struct Scene {
-  SimTK::MultibodySystem system;
-  SimTK::SimbodyMatterSubsystem matter{system};
-  SimTK::GeneralForceSubsystem forces{system};
-  SimTK::Force::Gravity gravity{forces, matter, -SimTK::ZAxis, kGravity};
-  SimTK::MobilizedBody::Free ball;
+struct Scene : BallWorld {
+  using BallWorld::BallWorld;
   std::unique_ptr<CompliantContact> contact;
-  Scene(double mass, double inertia)
-      : ball(matter.Ground(), SimTK::Transform(),
-             SimTK::Body::Rigid(SimTK::MassProperties(mass, SimTK::Vec3(0), SimTK::UnitInertia(inertia / mass))),
-             SimTK::Transform()) {}
 
-  Run simulate(SimTK::State state, double duration) {
-    SimTK::RungeKuttaMersonIntegrator integrator(system);
-    integrator.setAccuracy(1e-6);
-    SimTK::TimeStepper stepper(system, integrator);
-    stepper.initialize(state);
-    stepper.stepTo(duration);
-    return {integrator.getNumStepsTaken(), duration, contact ? contact->counters().evaluations : 0};
+  Run simulate(const SimTK::State& state, double duration) {
+    Simulation run(system, state, 1e-6);
+    run.stepTo(duration);
+    return {run.integrator.getNumStepsTaken(), duration, contact ? contact->counters().evaluations : 0};
   }
 };
 
@@ -55,8 +46,7 @@ constexpr double kMass = 1.0, kRadius = 0.05, kSurfaceModulus = 1e8, kDissipatio
                  kTransition = 0.01;
 
 SimTK::State sphereOnPlaneStart(Scene& scene) {
-  scene.system.realizeTopology();
-  SimTK::State state = scene.system.getDefaultState();
+  SimTK::State state = scene.start();
   scene.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, kRadius + 0.01));
   scene.ball.setUToFitVelocity(state, SimTK::SpatialVec(SimTK::Vec3(0, 20, 3), SimTK::Vec3(1.0, 0.2, 0)));
   return state;
@@ -125,8 +115,7 @@ void BM_BallInBowl_Thesis(benchmark::State& state) {
     laws.friction.transition_speed = 1e-3;
     scene.contact = std::make_unique<CompliantContact>(scene.forces);
     scene.contact->addSphereInCavity(scene.ball, r, Vector3d(0, 0, R), R, laws);
-    scene.system.realizeTopology();
-    SimTK::State start = scene.system.getDefaultState();
+    SimTK::State start = scene.start();
     scene.ball.setQToFitTranslation(start, SimTK::Vec3(R - r, 0, R));
     scene.ball.setUToFitAngularVelocity(start, SimTK::Vec3(0, 9.0, 0));
     run = scene.simulate(start, 10.0);

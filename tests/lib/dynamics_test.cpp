@@ -13,6 +13,7 @@
 
 #include "articula/contact/convex_shape.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
+#include "articula/testsupport/ball_world.hpp"
 
 namespace {
 
@@ -21,19 +22,9 @@ using articula::dynamics::CompliantContact;
 using articula::dynamics::ContactLaws;
 using Eigen::Vector3d;
 
-constexpr double kGravity = 9.81;
-
-struct BallWorld {
-  SimTK::MultibodySystem system;
-  SimTK::SimbodyMatterSubsystem matter{system};
-  SimTK::GeneralForceSubsystem forces{system};
-  SimTK::Force::Gravity gravity{forces, matter, -SimTK::ZAxis, kGravity};
-  SimTK::MobilizedBody::Free ball;
-  BallWorld(double mass, double inertia)
-      : ball(matter.Ground(), SimTK::Transform(),
-             SimTK::Body::Rigid(SimTK::MassProperties(mass, SimTK::Vec3(0), SimTK::UnitInertia(inertia / mass))),
-             SimTK::Transform()) {}
-};
+using articula::testsupport::BallWorld;
+using articula::testsupport::kGravity;
+using articula::testsupport::Simulation;
 
 articula::contact::ConvexShape sphere(double r) {
   return articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), Vector3d::Constant(r));
@@ -55,15 +46,10 @@ TEST(Dynamics, ABallSettlesOnAPlaneAtTheHertzDepth) {
   CompliantContact contact(w.forces);
   contact.addShapeOnPlane(w.ball, sphere(r), Vector3d::Zero(), Vector3d::UnitZ(),
                           hertzLaws(K, NormalLaw::HuntCrossley, 5.0, 0.0));
-  w.system.realizeTopology();
-  SimTK::State state = w.system.getDefaultState();
+  SimTK::State state = w.start();
   w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, r + 0.002));
-  SimTK::RungeKuttaMersonIntegrator integrator(w.system);
-  integrator.setAccuracy(1e-9);
-  SimTK::TimeStepper stepper(w.system, integrator);
-  stepper.initialize(state);
-  stepper.stepTo(3.0);
-  const double depth = r - w.ball.getBodyOriginLocation(integrator.getState())[2];
+  Simulation run(w.system, state, 1e-9);
+  const double depth = r - w.ball.getBodyOriginLocation(run.stepTo(3.0))[2];
   const double hertz = std::pow(m * kGravity / K, 2.0 / 3.0);
   EXPECT_NEAR(depth, hertz, 1e-6 * hertz);
   EXPECT_GT(contact.counters().in_contact, 0);
@@ -75,20 +61,15 @@ TEST(Dynamics, AnElasticBounceKeepsItsEnergy) {
   CompliantContact contact(w.forces);
   contact.addShapeOnPlane(w.ball, sphere(r), Vector3d::Zero(), Vector3d::UnitZ(),
                           hertzLaws(K, NormalLaw::Hertz, 0.0, 0.0));
-  w.system.realizeTopology();
-  SimTK::State state = w.system.getDefaultState();
+  SimTK::State state = w.start();
   w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, r + 0.2));
   w.ball.setUToFitLinearVelocity(state, SimTK::Vec3(0.3, 0, 0));
   w.system.realize(state, SimTK::Stage::Dynamics);
   const double e0 = w.system.calcEnergy(state);
-  SimTK::RungeKuttaMersonIntegrator integrator(w.system);
-  integrator.setAccuracy(1e-10);
-  SimTK::TimeStepper stepper(w.system, integrator);
-  stepper.initialize(state);
+  Simulation run(w.system, state, 1e-10);
   double worst = 0;
   for (int i = 1; i <= 100; ++i) {
-    stepper.stepTo(0.1 * i);
-    const SimTK::State& s = integrator.getState();
+    const SimTK::State& s = run.stepTo(0.1 * i);
     w.system.realize(s, SimTK::Stage::Dynamics);
     worst = std::max(worst, std::fabs(w.system.calcEnergy(s) - e0) / std::fabs(e0));
   }
@@ -105,23 +86,18 @@ TEST(Dynamics, ABallRollingInABowlOscillatesWithTheRollingPeriod) {
   ContactLaws laws = hertzLaws(K, NormalLaw::HuntCrossley, 0.1, 0.5);
   laws.friction.transition_speed = 1e-3;
   contact.addSphereInCavity(w.ball, r, Vector3d(0, 0, R), R, laws);
-  w.system.realizeTopology();
-  SimTK::State state = w.system.getDefaultState();
+  SimTK::State state = w.start();
   const double angle = 0.05;  // from the bottom, about the y axis
   const double sag = std::pow(m * kGravity / K, 2.0 / 3.0);
   const double arm = R - r + sag;
   w.ball.setQToFitTranslation(state, SimTK::Vec3(arm * std::sin(angle), 0, R - arm * std::cos(angle)));
-  SimTK::RungeKuttaMersonIntegrator integrator(w.system);
-  integrator.setAccuracy(1e-8);
-  SimTK::TimeStepper stepper(w.system, integrator);
-  stepper.initialize(state);
+  Simulation run(w.system, state, 1e-8);
   // Crossings of x = 0 (linear interpolation between samples), half a period apart.
   std::vector<double> crossings;
-  double t_prev = 0, x_prev = w.ball.getBodyOriginLocation(integrator.getState())[0];
+  double t_prev = 0, x_prev = w.ball.getBodyOriginLocation(run.integrator.getState())[0];
   const double dt = 1e-3;
   for (int i = 1; i <= 4000 && crossings.size() < 3; ++i) {
-    stepper.stepTo(i * dt);
-    const double x = w.ball.getBodyOriginLocation(integrator.getState())[0];
+    const double x = w.ball.getBodyOriginLocation(run.stepTo(i * dt))[0];
     if ((x_prev < 0) != (x < 0)) crossings.push_back(t_prev + dt * (-x_prev) / (x - x_prev));
     t_prev = i * dt;
     x_prev = x;
@@ -159,19 +135,12 @@ TEST(Dynamics, ASphereOnAPlaneFollowsSimbodysHuntCrossley) {
       hc.setBodyParameters(SimTK::ContactSurfaceIndex(1), k_surface, c, mu_s, mu_d, 0);
       hc.setTransitionVelocity(vt);
     }
-    w.system.realizeTopology();
-    SimTK::State state = w.system.getDefaultState();
+    SimTK::State state = w.start();
     w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, r + 0.01));
     w.ball.setUToFitVelocity(state, SimTK::SpatialVec(SimTK::Vec3(0, 20, 3), SimTK::Vec3(1.0, 0.2, 0)));
-    SimTK::RungeKuttaMersonIntegrator integrator(w.system);
-    integrator.setAccuracy(1e-10);
-    SimTK::TimeStepper stepper(w.system, integrator);
-    stepper.initialize(state);
+    Simulation run(w.system, state, 1e-10);
     std::vector<SimTK::Vec3> path;
-    for (int i = 1; i <= 50; ++i) {
-      stepper.stepTo(0.01 * i);
-      path.push_back(w.ball.getBodyOriginLocation(integrator.getState()));
-    }
+    for (int i = 1; i <= 50; ++i) path.push_back(w.ball.getBodyOriginLocation(run.stepTo(0.01 * i)));
     return path;
   };
   const std::vector<SimTK::Vec3> ours = simulate(true), simbody = simulate(false);
