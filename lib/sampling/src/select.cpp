@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Dense>
@@ -85,13 +86,15 @@ constexpr double kMinEllipsoidBandMm = 0.4;
 std::vector<int> ellipsoidBand(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
                                const std::vector<int>& patch, double band_mm, double cos_tol) {
   geometry::ShapeParameters ellipsoid;
+  std::optional<distance::SignedDistance> fitted;
   try {
     ellipsoid = fit::algebraicEllipsoid(rowsOf(V, patch));
+    if (!(ellipsoid.radii.maxCoeff() < 4 * ellipsoid.radii.minCoeff())) return patch;  // not a head's shape
+    fitted.emplace(ellipsoid);
   } catch (const Error&) {
     return patch;
   }
-  if (!(ellipsoid.radii.maxCoeff() < 4 * ellipsoid.radii.minCoeff())) return patch;  // not a head's shape
-  const distance::SignedDistance exact(ellipsoid);
+  const distance::SignedDistance& exact = *fitted;
   std::vector<double> scatter;
   scatter.reserve(patch.size());
   for (int v : patch) scatter.push_back(std::fabs(exact.closest(V.row(v).transpose()).distance));
