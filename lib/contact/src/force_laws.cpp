@@ -96,6 +96,7 @@ double FrictionLaw::coefficient(double v) const {
 ContactForce contactForce(const ContactState& s, const NormalForceLaw& normal_law, const FrictionLaw& friction) {
   ContactForce f;
   f.point = 0.5 * (s.point_a + s.point_b);
+  f.depth = s.depth;
   const Eigen::Vector3d relative = s.velocity_b - s.velocity_a;  // of B on A
   f.depth_rate = -relative.dot(s.normal);  // B moving against the normal: approaching
   // Friction in the Householder frame of the normal: continuous as the

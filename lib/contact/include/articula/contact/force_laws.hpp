@@ -83,6 +83,7 @@ struct ContactForce {
   double normal = 0;                                   // normal force, >= 0
   Eigen::Vector2d friction_tb = Eigen::Vector2d::Zero();  // friction on B in the Householder frame (t, b) of the normal
   Eigen::Vector2d slip_tb = Eigen::Vector2d::Zero();      // slip velocity of B relative to A in that frame
+  double depth = 0;                                    // penetration, > 0 in contact
   double depth_rate = 0;                               // d' > 0 while approaching
 };
 

@@ -1,0 +1,33 @@
+#pragma once
+// Runs a scene (scene.hpp) on Simbody with articula's compliant contact and
+// writes, into a folder: trajectory.csv (every body's position, orientation
+// quaternion, velocities, and the system's energies, at each output time),
+// contacts.csv (each contact's depth, normal and friction forces and point),
+// steps.csv (every internal integrator step) and nothing else; the summary
+// is returned for the caller to write with its provenance.
+#include <filesystem>
+#include <functional>
+
+#include <nlohmann/json.hpp>
+
+#include "articula/dynamics/scene.hpp"
+
+namespace articula::dynamics {
+
+struct SimulationSummary {
+  double simulated_seconds = 0;
+  double wall_seconds = 0;
+  long long steps = 0;
+  double mean_step = 0, min_step = 0, max_step = 0;  // s
+  long long contact_evaluations = 0;
+  long long output_rows = 0;
+  double energy_start = 0, energy_end = 0;  // kinetic + gravitational + elastic contact, J
+  nlohmann::json toJson() const;
+};
+
+/// Simulates `scene` and writes the three tables into `folder` (which must
+/// exist); `progress(t)` is called at every output time.
+SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path& folder,
+                                const std::function<void(double)>& progress = {});
+
+}  // namespace articula::dynamics

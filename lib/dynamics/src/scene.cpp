@@ -1,0 +1,227 @@
+#include "articula/dynamics/scene.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <optional>
+
+#include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
+#include "articula/geometry/pose.hpp"
+
+namespace articula::dynamics {
+namespace {
+
+using nlohmann::json;
+constexpr double kDegree = M_PI / 180.0;
+
+[[noreturn]] void refuse(const std::string& where, const std::string& field, const std::string& expected,
+                         const json& found) {
+  throw InputError(where + ": " + field + ": expected " + expected + ", found " + describeJson(found));
+}
+
+const json* member(const json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+double number(const json& object, const char* key, const std::string& where, std::optional<double> fallback,
+              double lo, double hi, const std::string& range) {
+  const json* v = member(object, key);
+  if (!v) {
+    if (fallback) return *fallback;
+    throw InputError(where + ": missing \"" + key + "\" (" + range + ")");
+  }
+  if (!v->is_number() || !(v->get<double>() >= lo && v->get<double>() <= hi)) refuse(where, key, range, *v);
+  return v->get<double>();
+}
+
+Eigen::Vector3d vector3(const json& object, const char* key, const std::string& where,
+                        std::optional<Eigen::Vector3d> fallback, double limit = 1e6) {
+  const json* v = member(object, key);
+  if (!v) {
+    if (fallback) return *fallback;
+    throw InputError(where + ": missing \"" + key + "\" (three numbers)");
+  }
+  if (!v->is_array() || v->size() != 3) refuse(where, key, "three numbers", *v);
+  Eigen::Vector3d out;
+  for (int i = 0; i < 3; ++i) {
+    const json& x = (*v)[static_cast<size_t>(i)];
+    if (!x.is_number() || !(std::fabs(x.get<double>()) <= limit))
+      refuse(where, key, "three numbers within +-" + excerpt(std::to_string(limit)), *v);
+    out[i] = x.get<double>();
+  }
+  return out;
+}
+
+std::string text(const json& object, const char* key, const std::string& where, std::optional<std::string> fallback) {
+  const json* v = member(object, key);
+  if (!v) {
+    if (fallback) return *fallback;
+    throw InputError(where + ": missing \"" + key + "\"");
+  }
+  if (!v->is_string()) refuse(where, key, "a string", *v);
+  return v->get<std::string>();
+}
+
+const json& object(const json& parent, const char* key, const std::string& where) {
+  const json* v = member(parent, key);
+  if (!v) throw InputError(where + ": missing \"" + key + "\" (an object)");
+  if (!v->is_object()) refuse(where, key, "an object", *v);
+  return *v;
+}
+
+SceneBody readBody(const json& j, const std::string& where) {
+  if (!j.is_object()) refuse(where, "body", "an object", j);
+  SceneBody b;
+  b.name = text(j, "name", where, std::nullopt);
+  b.mass = number(j, "mass", where, std::nullopt, 1e-9, 1e9, "a mass in kg, 1e-9 to 1e9");
+  b.inertia = vector3(j, "inertia", where, std::nullopt, 1e9);
+  const Eigen::Vector3d& I = b.inertia;
+  if (!(I.minCoeff() > 0) || I[0] + I[1] < I[2] || I[1] + I[2] < I[0] || I[0] + I[2] < I[1])
+    refuse(where, "inertia", "principal moments > 0 that satisfy the triangle inequality", j.at("inertia"));
+  b.position = vector3(j, "position", where, Eigen::Vector3d::Zero());
+  b.angles_deg = vector3(j, "angles_deg", where, Eigen::Vector3d::Zero(), 3600);
+  b.velocity = vector3(j, "velocity", where, Eigen::Vector3d::Zero(), 1e4);
+  b.angular_velocity = vector3(j, "angular_velocity", where, Eigen::Vector3d::Zero(), 1e5);
+  return b;
+}
+
+ContactLaws readLaws(const json& j, const std::string& where) {
+  ContactLaws laws;
+  const json& n = object(j, "normal_law", where);
+  const std::string w = where + " normal_law";
+  const std::string law = text(n, "law", w, "hunt-crossley");
+  if (law == "hertz") {
+    laws.normal.law = contact::NormalLaw::Hertz;
+  } else if (law == "hunt-crossley") {
+    laws.normal.law = contact::NormalLaw::HuntCrossley;
+    laws.normal.dissipation = number(n, "dissipation", w, 0.0, 0, 1e6, "a dissipation >= 0 (s/m)");
+  } else if (law == "lankarani-nikravesh") {
+    laws.normal.law = contact::NormalLaw::LankaraniNikravesh;
+    laws.normal.restitution = number(n, "restitution", w, std::nullopt, 1e-6, 1, "a restitution in (0, 1]");
+    laws.normal.impact_speed = number(n, "impact_speed", w, std::nullopt, 1e-9, 1e4, "an impact speed > 0 (m/s)");
+  } else {
+    refuse(w, "law", "hertz, hunt-crossley or lankarani-nikravesh", n.at("law"));
+  }
+  laws.normal.stiffness = number(n, "stiffness", w, std::nullopt, 1e-9, 1e15, "a stiffness > 0 (N/m^exponent)");
+  laws.normal.exponent = number(n, "exponent", w, 1.5, 1, 3, "an exponent of 1 to 3");
+  if (const json* f = member(j, "friction")) {
+    const std::string fw = where + " friction";
+    if (!f->is_object()) refuse(where, "friction", "an object", *f);
+    laws.friction.dynamic = number(*f, "dynamic", fw, 0.0, 0, 10, "a coefficient of 0 to 10");
+    laws.friction.static_peak = number(*f, "static", fw, laws.friction.dynamic, 0, 10, "a coefficient of 0 to 10");
+    laws.friction.viscous = number(*f, "viscous", fw, 0.0, 0, 1e6, "a coefficient >= 0 (s/m)");
+    laws.friction.transition_speed = number(*f, "transition_speed", fw, 1e-3, 1e-9, 1e3, "a speed > 0 (m/s)");
+  }
+  return laws;
+}
+
+SceneContact readContact(const json& j, const std::string& where, const std::vector<SceneBody>& bodies) {
+  if (!j.is_object()) refuse(where, "contact", "an object", j);
+  SceneContact c;
+  const std::string body = text(j, "body", where, std::nullopt);
+  c.body = -1;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].name == body) c.body = static_cast<int>(i);
+  if (c.body < 0) throw InputError(where + ": body \"" + excerpt(body) + "\" is not one of the scene's bodies");
+  const json& s = object(j, "shape", where);
+  const std::string sw = where + " shape";
+  const std::string model = text(s, "model", sw, std::nullopt);
+  if (model != "sphere" && model != "ellipsoid" && model != "superellipsoid")
+    refuse(sw, "model", "sphere, ellipsoid or superellipsoid", s.at("model"));
+  const Eigen::Vector3d radii = vector3(s, "radii", sw, std::nullopt, 1e3);
+  const Eigen::Vector3d exponents = vector3(s, "exponents", sw, Eigen::Vector3d::Constant(2.0), 1e3);
+  if (model != "superellipsoid" && exponents != Eigen::Vector3d::Constant(2.0))
+    refuse(sw, "exponents", "2, 2, 2 for a " + model, s.at("exponents"));
+  if (model == "sphere" && !(radii.maxCoeff() == radii.minCoeff()))
+    refuse(sw, "radii", "three equal radii for a sphere", s.at("radii"));
+  const Eigen::Vector3d center = vector3(s, "center", sw, Eigen::Vector3d::Zero(), 1e3);
+  const Eigen::Matrix3d rotation = geometry::rotationFromAngles(kDegree * vector3(s, "angles_deg", sw, Eigen::Vector3d::Zero(), 3600));
+  try {
+    c.shape = contact::makeConvexShape(center, rotation, radii, exponents);
+  } catch (const Error& e) {
+    throw InputError(sw + ": " + e.what());
+  }
+  const json& against = object(j, "against", where);
+  if (const json* plane = member(against, "plane")) {
+    const std::string pw = where + " against plane";
+    if (!plane->is_object()) refuse(where, "against plane", "an object", *plane);
+    c.point = vector3(*plane, "point", pw, Eigen::Vector3d::Zero());
+    c.normal = vector3(*plane, "normal", pw, std::nullopt);
+    if (!(c.normal.norm() > 0)) refuse(pw, "normal", "a non-zero vector", plane->at("normal"));
+  } else if (const json* cavity = member(against, "cavity")) {
+    const std::string cw = where + " against cavity";
+    if (!cavity->is_object()) refuse(where, "against cavity", "an object", *cavity);
+    if (model != "sphere" || center != Eigen::Vector3d::Zero())
+      throw InputError(cw + ": a cavity holds a sphere centred at its body's origin (shape center [0, 0, 0])");
+    c.cavity = true;
+    c.point = vector3(*cavity, "center", cw, std::nullopt);
+    c.cavity_radius = number(*cavity, "radius", cw, std::nullopt, radii[0] * (1 + 1e-9), 1e6,
+                             "a radius larger than the sphere's");
+  } else {
+    throw InputError(where + ": against: expected {\"plane\": ...} or {\"cavity\": ...}, found " + describeJson(against));
+  }
+  c.laws = readLaws(j, where);
+  try {
+    c.laws.normal.validate();
+    c.laws.friction.validate();
+  } catch (const Error& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  return c;
+}
+
+}  // namespace
+
+Scene sceneFromJson(const json& document, const std::string& where) {
+  if (!document.is_object()) refuse(where, "scene", "a JSON object", document);
+  Scene scene;
+  scene.source = document;
+  scene.gravity = vector3(document, "gravity", where, Eigen::Vector3d(0, 0, -9.81), 1e4);
+  scene.duration = number(document, "duration", where, std::nullopt, 1e-9, 1e5, "a duration of up to 1e5 s");
+  scene.output_interval = number(document, "output_interval", where, 0.01, 1e-9, 1e5, "an interval > 0 (s)");
+  if (scene.duration / scene.output_interval > 1e6)
+    throw InputError(where + ": output_interval: more than 1e6 output rows (duration / output_interval)");
+  if (const json* in = member(document, "integrator")) {
+    const std::string w = where + " integrator";
+    if (!in->is_object()) refuse(where, "integrator", "an object", *in);
+    const std::string type = text(*in, "type", w, "runge-kutta-merson");
+    if (type == "runge-kutta-merson") scene.integrator = IntegratorKind::RungeKuttaMerson;
+    else if (type == "cpodes") scene.integrator = IntegratorKind::CPodes;
+    else if (type == "semi-explicit-euler") scene.integrator = IntegratorKind::SemiExplicitEuler;
+    else refuse(w, "type", "runge-kutta-merson, cpodes or semi-explicit-euler", in->at("type"));
+    scene.accuracy = number(*in, "accuracy", w, 1e-6, 1e-14, 1, "an accuracy in [1e-14, 1]");
+  }
+  const json* bodies = member(document, "bodies");
+  if (!bodies || !bodies->is_array() || bodies->empty() || bodies->size() > 1000)
+    throw InputError(where + ": bodies: expected an array of 1 to 1000 bodies, found " +
+                     (bodies ? describeJson(*bodies) : std::string("nothing")));
+  for (size_t i = 0; i < bodies->size(); ++i) {
+    scene.bodies.push_back(readBody((*bodies)[i], where + " bodies[" + std::to_string(i) + "]"));
+    for (size_t k = 0; k < i; ++k)
+      if (scene.bodies[k].name == scene.bodies[i].name)
+        throw InputError(where + ": bodies[" + std::to_string(i) + "]: the name \"" + excerpt(scene.bodies[i].name) +
+                         "\" is taken by bodies[" + std::to_string(k) + "]");
+  }
+  if (const json* contacts = member(document, "contacts")) {
+    if (!contacts->is_array() || contacts->size() > 10000)
+      refuse(where, "contacts", "an array of up to 10000 contacts", *contacts);
+    for (size_t i = 0; i < contacts->size(); ++i)
+      scene.contacts.push_back(readContact((*contacts)[i], where + " contacts[" + std::to_string(i) + "]", scene.bodies));
+  }
+  return scene;
+}
+
+Scene readScene(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open the scene '" + path.string() + "'");
+  json document;
+  try {
+    document = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(path.string() + ": not a JSON document: " + excerpt(e.what(), 120));
+  }
+  return sceneFromJson(document, path.string());
+}
+
+}  // namespace articula::dynamics
