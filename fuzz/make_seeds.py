@@ -277,6 +277,21 @@ def nifti_seeds():
         write("fuzz_nifti", name + ".nii.gz", b"\x01" + gzip.compress(data, mtime=0))
 
 
+def scene_seeds():
+    scenes = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes")
+    for name in sorted(os.listdir(scenes)):
+        with open(os.path.join(scenes, name)) as f:
+            scene = json.load(f)
+        scene.pop("description", None)
+        write("fuzz_scene", name, json.dumps(scene))
+    write("fuzz_scene", "superellipsoid_plane.json", json.dumps({
+        "duration": 1, "bodies": [{"name": "b", "mass": 1, "inertia": [1, 1, 1]}],
+        "contacts": [{"body": "b", "shape": {"model": "superellipsoid", "radii": [1, 1, 2], "exponents": [2, 3, 4]},
+                      "against": {"plane": {"normal": [0, 0, 1]}},
+                      "normal_law": {"law": "lankarani-nikravesh", "stiffness": 1e6, "restitution": 0.8, "impact_speed": 1},
+                      "friction": {"dynamic": 0.2, "static": 0.3, "viscous": 0.1}}]}))
+
+
 def main():
     ply_seeds()
     table_seeds()
@@ -285,6 +300,7 @@ def main():
     pairs_seeds()
     manifest_seeds()
     nifti_seeds()
+    scene_seeds()
 
 
 if __name__ == "__main__":
