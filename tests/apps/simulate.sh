@@ -41,6 +41,18 @@ PY
 expect_rc 0 "$bin/articula" simulate -i "$src/scenes/ellipsoid_spin.json" -o "$tmp/egg" -q
 [ "$(wc -l < "$tmp/egg/contacts.csv")" -gt 50 ] || fail "the ellipsoid never touched its plane"
 
+# Two free bodies in zero gravity: the pair's forces are equal and opposite.
+expect_rc 0 "$bin/articula" simulate -i "$src/scenes/two_ellipsoids.json" -o "$tmp/two" -q
+python3 - "$tmp/two/trajectory.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+def momentum(r):
+    return [float(r[f"a_v{c}_m_s"]) + 3.0 * float(r[f"b_v{c}_m_s"]) for c in "xyz"]
+start, end = momentum(rows[0]), momentum(rows[-1])
+assert max(abs(a - b) for a, b in zip(start, end)) < 1e-8, (start, end)
+assert float(rows[-1]["b_vx_m_s"]) > 0.1, "they never collided"
+PY
+
 # A second run refuses to overwrite; --force redoes it.
 expect_rc 2 "$bin/articula" simulate -i "$tmp/bowl.json" -o "$tmp/bowl"
 grep -q "refusing to overwrite" "$tmp/err" || fail "overwrite message: $(cat "$tmp/err")"
@@ -61,6 +73,7 @@ PY
 bad negative-mass 'scene["bodies"][0]["mass"] = -1' 'mass: expected a mass in kg'
 bad no-bodies 'del scene["bodies"]' 'bodies: expected an array of 1 to 1000 bodies'
 bad unknown-body 'scene["contacts"][0]["body"] = "nobody"' 'body "nobody" is not one of'
+bad self-pair 'scene["contacts"][0]["against"] = {"body": "ball", "shape": {"model": "sphere", "radii": [1, 1, 1]}}' 'is not another of the scene'"'"'s bodies'
 bad cavity-ellipsoid 'scene["contacts"][0]["shape"] = {"model": "ellipsoid", "radii": [0.1, 0.1, 0.12]}' 'a cavity holds a sphere'
 bad small-cavity 'scene["contacts"][0]["against"]["cavity"]["radius"] = 0.05' 'a radius larger than the sphere'
 bad law 'scene["contacts"][0]["normal_law"]["law"] = "spring"' 'hertz, hunt-crossley or lankarani-nikravesh'

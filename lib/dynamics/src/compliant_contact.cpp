@@ -1,8 +1,10 @@
 #include "articula/dynamics/compliant_contact.hpp"
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
+#include "articula/contact/common_normal.hpp"
 #include "articula/contact/plane_contact.hpp"
 #include "articula/core/error.hpp"
 
@@ -19,16 +21,30 @@ Eigen::Matrix3d toEigen(const SimTK::Rotation& r) {
   return m;
 }
 
-enum class PairKind { ShapeOnPlane, SphereInCavity };
+enum class PairKind { ShapeOnPlane, SphereInCavity, ShapePair };
 
 struct Pair {
-  PairKind kind;
+  PairKind kind = PairKind::ShapeOnPlane;
   SimTK::MobilizedBodyIndex body;
-  contact::ConvexShape shape;                  // ShapeOnPlane: in the body's frame
+  contact::ConvexShape shape;                  // ShapeOnPlane, ShapePair (A): in the body's frame
   double radius = 0, cavity_radius = 0;        // SphereInCavity
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // plane, or cavity centre
   ContactLaws laws;
+  SimTK::MobilizedBodyIndex body_b;            // ShapePair: B and its shape in its frame
+  contact::ConvexShape shape_b;
+  // The pair's last answer: the next evaluation's warm start. Simbody also
+  // evaluates trial states (rejected steps, Runge-Kutta stages); any nearby
+  // answer is a good start, and the solver's certificates keep the result
+  // the global one.
+  mutable std::optional<contact::ContactResult> last;
 };
+
+contact::ConvexShape inGround(const contact::ConvexShape& shape, const SimTK::Transform& X_GB) {
+  contact::ConvexShape world = shape;
+  world.center = toEigen(X_GB * toSimTK(shape.center));
+  world.rotation = toEigen(X_GB.R()) * shape.rotation;
+  return world;
+}
 
 }  // namespace
 
@@ -40,15 +56,25 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
   mutable ContactCounters counters;
 
   // The contact of pair p at `state`: A is the moving body, B the ground.
+  // stateOf fills `station` (and `station_b` for a shape pair): where the force acts, in each body's frame.
+  mutable SimTK::Vec3 station_b;
+
   contact::ContactState stateOf(const Pair& p, const SimTK::State& state, SimTK::Vec3& station) const {
     const SimTK::MobilizedBody& body = matter_.getMobilizedBody(p.body);
     const SimTK::Transform& X_GB = body.getBodyTransform(state);
     contact::ContactState s;
-    if (p.kind == PairKind::ShapeOnPlane) {
-      contact::ConvexShape world = p.shape;
-      world.center = toEigen(X_GB * toSimTK(p.shape.center));
-      world.rotation = toEigen(X_GB.R()) * p.shape.rotation;
-      const contact::ContactResult r = contact::shapePlaneContact(world, p.point, p.normal);
+    if (p.kind == PairKind::ShapePair) {
+      const SimTK::Transform& X_GB2 = matter_.getMobilizedBody(p.body_b).getBodyTransform(state);
+      const contact::ContactResult r = contact::computeContact(inGround(p.shape, X_GB), inGround(p.shape_b, X_GB2), {},
+                                                               p.last ? &*p.last : nullptr);
+      if (p.last) ++counters.warm_starts;
+      p.last = r;
+      s.point_a = r.point_a;
+      s.point_b = r.point_b;
+      s.normal = r.normal;  // outward of A at its point: towards B
+      s.depth = -r.distance;
+    } else if (p.kind == PairKind::ShapeOnPlane) {
+      const contact::ContactResult r = contact::shapePlaneContact(inGround(p.shape, X_GB), p.point, p.normal);
       s.point_a = r.point_a;
       s.point_b = r.point_b;
       s.normal = r.normal;  // outward of the shape: towards the plane's solid
@@ -67,6 +93,11 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
     const Eigen::Vector3d at = 0.5 * (s.point_a + s.point_b);
     station = X_GB.shiftBaseStationToFrame(toSimTK(at));
     s.velocity_a = toEigen(body.findStationVelocityInGround(state, station));
+    if (p.kind == PairKind::ShapePair) {
+      const SimTK::MobilizedBody& b = matter_.getMobilizedBody(p.body_b);
+      station_b = b.getBodyTransform(state).shiftBaseStationToFrame(toSimTK(at));
+      s.velocity_b = toEigen(b.findStationVelocityInGround(state, station_b));
+    }
     return s;
   }
 
@@ -80,6 +111,8 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
       ++counters.in_contact;
       const contact::ContactForce f = contact::contactForce(s, p.laws.normal, p.laws.friction);
       matter_.getMobilizedBody(p.body).applyForceToBodyPoint(state, station, toSimTK(-f.on_b), body_forces);
+      if (p.kind == PairKind::ShapePair)
+        matter_.getMobilizedBody(p.body_b).applyForceToBodyPoint(state, station_b, toSimTK(f.on_b), body_forces);
     }
   }
 
@@ -115,7 +148,13 @@ void CompliantContact::addShapeOnPlane(const SimTK::MobilizedBody& body, const c
   laws.friction.validate();
   if (!(plane_normal.allFinite() && plane_normal.norm() > 0 && plane_point.allFinite()))
     throw InvalidParameter("contact plane normal", "a finite non-zero vector", plane_normal.norm());
-  Pair p{PairKind::ShapeOnPlane, body.getMobilizedBodyIndex(), shape, 0, 0, plane_point, plane_normal.normalized(), laws};
+  Pair p;
+  p.kind = PairKind::ShapeOnPlane;
+  p.body = body.getMobilizedBodyIndex();
+  p.shape = shape;
+  p.point = plane_point;
+  p.normal = plane_normal.normalized();
+  p.laws = laws;
   element_->pairs.push_back(p);
 }
 
@@ -127,8 +166,30 @@ void CompliantContact::addSphereInCavity(const SimTK::MobilizedBody& body, doubl
   if (!(radius > 0 && std::isfinite(radius))) throw InvalidParameter("ball radius", "> 0", radius);
   if (!(cavity_radius > radius && std::isfinite(cavity_radius)))
     throw InvalidParameter("cavity radius", "larger than the ball's", cavity_radius);
-  Pair p{PairKind::SphereInCavity, body.getMobilizedBodyIndex(), {}, radius, cavity_radius, cavity_center,
-         Eigen::Vector3d::UnitZ(), laws};
+  Pair p;
+  p.kind = PairKind::SphereInCavity;
+  p.body = body.getMobilizedBodyIndex();
+  p.radius = radius;
+  p.cavity_radius = cavity_radius;
+  p.point = cavity_center;
+  p.laws = laws;
+  element_->pairs.push_back(p);
+}
+
+void CompliantContact::addShapePair(const SimTK::MobilizedBody& body_a, const contact::ConvexShape& shape_a,
+                                    const SimTK::MobilizedBody& body_b, const contact::ConvexShape& shape_b,
+                                    const ContactLaws& laws) {
+  laws.normal.validate();
+  laws.friction.validate();
+  if (body_a.getMobilizedBodyIndex() == body_b.getMobilizedBodyIndex())
+    throw InvalidParameter("contact pair", "two different bodies", static_cast<double>(body_a.getMobilizedBodyIndex()));
+  Pair p;
+  p.kind = PairKind::ShapePair;
+  p.body = body_a.getMobilizedBodyIndex();
+  p.shape = shape_a;
+  p.body_b = body_b.getMobilizedBodyIndex();
+  p.shape_b = shape_b;
+  p.laws = laws;
   element_->pairs.push_back(p);
 }
 

@@ -116,16 +116,7 @@ ContactLaws readLaws(const json& j, const std::string& where) {
   return laws;
 }
 
-SceneContact readContact(const json& j, const std::string& where, const std::vector<SceneBody>& bodies) {
-  if (!j.is_object()) refuse(where, "contact", "an object", j);
-  SceneContact c;
-  const std::string body = text(j, "body", where, std::nullopt);
-  c.body = -1;
-  for (size_t i = 0; i < bodies.size(); ++i)
-    if (bodies[i].name == body) c.body = static_cast<int>(i);
-  if (c.body < 0) throw InputError(where + ": body \"" + excerpt(body) + "\" is not one of the scene's bodies");
-  const json& s = object(j, "shape", where);
-  const std::string sw = where + " shape";
+contact::ConvexShape readShape(const json& s, const std::string& sw) {
   const std::string model = text(s, "model", sw, std::nullopt);
   if (model != "sphere" && model != "ellipsoid" && model != "superellipsoid")
     refuse(sw, "model", "sphere, ellipsoid or superellipsoid", s.at("model"));
@@ -138,10 +129,24 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   const Eigen::Vector3d center = vector3(s, "center", sw, Eigen::Vector3d::Zero(), 1e3);
   const Eigen::Matrix3d rotation = geometry::rotationFromAngles(kDegree * vector3(s, "angles_deg", sw, Eigen::Vector3d::Zero(), 3600));
   try {
-    c.shape = contact::makeConvexShape(center, rotation, radii, exponents);
+    return contact::makeConvexShape(center, rotation, radii, exponents);
   } catch (const Error& e) {
     throw InputError(sw + ": " + e.what());
   }
+}
+
+SceneContact readContact(const json& j, const std::string& where, const std::vector<SceneBody>& bodies) {
+  if (!j.is_object()) refuse(where, "contact", "an object", j);
+  SceneContact c;
+  const std::string body = text(j, "body", where, std::nullopt);
+  c.body = -1;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].name == body) c.body = static_cast<int>(i);
+  if (c.body < 0) throw InputError(where + ": body \"" + excerpt(body) + "\" is not one of the scene's bodies");
+  const json& s = object(j, "shape", where);
+  const std::string model = text(s, "model", where + " shape", std::nullopt);
+  c.shape = readShape(s, where + " shape");
+  const Eigen::Vector3d radii = c.shape.radii, center = c.shape.center;
   const json& against = object(j, "against", where);
   if (const json* plane = member(against, "plane")) {
     const std::string pw = where + " against plane";
@@ -158,8 +163,17 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
     c.point = vector3(*cavity, "center", cw, std::nullopt);
     c.cavity_radius = number(*cavity, "radius", cw, std::nullopt, radii[0] * (1 + 1e-9), 1e6,
                              "a radius larger than the sphere's");
+  } else if (const json* other = member(against, "body")) {
+    const std::string ow = where + " against";
+    if (!other->is_string()) refuse(ow, "body", "a body's name", *other);
+    for (size_t i = 0; i < bodies.size(); ++i)
+      if (bodies[i].name == other->get<std::string>()) c.other_body = static_cast<int>(i);
+    if (c.other_body < 0 || c.other_body == c.body)
+      throw InputError(ow + ": body \"" + excerpt(other->get<std::string>()) + "\" is not another of the scene's bodies");
+    c.other_shape = readShape(object(against, "shape", ow), ow + " shape");
   } else {
-    throw InputError(where + ": against: expected {\"plane\": ...} or {\"cavity\": ...}, found " + describeJson(against));
+    throw InputError(where + ": against: expected {\"plane\": ...}, {\"cavity\": ...} or {\"body\": ..., \"shape\": ...}, found " +
+                     describeJson(against));
   }
   c.laws = readLaws(j, where);
   try {

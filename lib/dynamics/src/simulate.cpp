@@ -57,7 +57,10 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
   }
   CompliantContact contact(forces);
   for (const SceneContact& c : scene.contacts) {
-    if (c.cavity)
+    if (c.other_body >= 0)
+      contact.addShapePair(bodies[static_cast<size_t>(c.body)], c.shape, bodies[static_cast<size_t>(c.other_body)],
+                           c.other_shape, c.laws);
+    else if (c.cavity)
       contact.addSphereInCavity(bodies[static_cast<size_t>(c.body)], c.shape.radii[0], c.point, c.cavity_radius, c.laws);
     else
       contact.addShapeOnPlane(bodies[static_cast<size_t>(c.body)], c.shape, c.point, c.normal, c.laws);

@@ -4,8 +4,10 @@
 // each force evaluation and applies the force laws of contact/force_laws.hpp
 // at the contact points. Pairs: a convex shape (sphere, ellipsoid,
 // superellipsoid) on a body against a plane fixed in ground (the closed form
-// of thesis section 5.3), and a sphere inside a spherical cavity fixed in
-// ground (conformal contact, thesis section 5.2.7). SI units.
+// of thesis section 5.3), a sphere inside a spherical cavity fixed in ground
+// (conformal contact, thesis section 5.2.7), and two convex shapes on any
+// two bodies (the common-normal / dual solver, warm-started per pair). SI
+// units.
 #include <memory>
 
 #include <Simbody.h>
@@ -24,6 +26,7 @@ struct ContactLaws {
 struct ContactCounters {
   long long evaluations = 0;  // pair evaluations (one per pair per force evaluation)
   long long in_contact = 0;   // of those, with positive depth
+  long long warm_starts = 0;  // shape pairs solved from their previous answer
 };
 
 class CompliantContact {
@@ -44,6 +47,12 @@ class CompliantContact {
   /// cavity of `cavity_radius` centred at `cavity_center` (ground).
   void addSphereInCavity(const SimTK::MobilizedBody& body, double radius, const Eigen::Vector3d& cavity_center,
                          double cavity_radius, const ContactLaws& laws);
+
+  /// Two convex shapes, each given in its body's frame (either body may be
+  /// Ground): the minimum signed distance of contact/common_normal.hpp,
+  /// warm-started from this pair's previous answer (thesis section 5.4.5).
+  void addShapePair(const SimTK::MobilizedBody& body_a, const contact::ConvexShape& shape_a,
+                    const SimTK::MobilizedBody& body_b, const contact::ConvexShape& shape_b, const ContactLaws& laws);
 
   const ContactCounters& counters() const;
 

@@ -2,7 +2,8 @@
 // A simulation scene as `articula simulate` reads it (docs/formats.md): free
 // rigid bodies under gravity, each with contact surfaces (sphere, ellipsoid,
 // superellipsoid in the thesis form) against a plane or inside a spherical
-// cavity fixed in ground, the contact laws, the integrator and the output.
+// cavity fixed in ground, or against another body's surface; the contact
+// laws, the integrator and the output.
 // SI units; angles in degrees in the file.
 #include <filesystem>
 #include <string>
@@ -29,7 +30,9 @@ struct SceneBody {
 struct SceneContact {
   int body = 0;                         // index into Scene::bodies
   contact::ConvexShape shape;           // in the body's frame
-  bool cavity = false;                  // against a spherical cavity (else a plane)
+  bool cavity = false;                  // against a spherical cavity
+  int other_body = -1;                  // against another body's shape (>= 0), else a plane or a cavity
+  contact::ConvexShape other_shape;     // in that body's frame
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // plane, or cavity centre
   double cavity_radius = 0;
   ContactLaws laws;
