@@ -25,6 +25,32 @@ for i in "${!expected[@]}"; do
   fi
 done
 
+# Many rows over two threads: the same file as on one, the threads reported.
+many="$ARTICULA_TMP/many.csv"
+python3 - "$ARTICULA_SOURCE/testdata/contact/pairs.csv" "$many" <<'PY'
+import math, random, sys
+header = open(sys.argv[1]).readline().strip()
+cols = header.split(",")
+rng = random.Random(7)
+with open(sys.argv[2], "w") as f:
+    f.write(header + "\n")
+    for _ in range(400):
+        row = {c: "" for c in cols}
+        for side, dx in (("a", 0.0), ("b", rng.uniform(0.5, 3.0))):
+            q = [rng.gauss(0, 1) for _ in range(4)]
+            n = math.sqrt(sum(v * v for v in q))
+            row.update({f"cx_{side}": dx, f"cy_{side}": rng.uniform(-0.5, 0.5), f"cz_{side}": 0,
+                        f"qw_{side}": q[0] / n, f"qx_{side}": q[1] / n, f"qy_{side}": q[2] / n, f"qz_{side}": q[3] / n,
+                        f"ra_{side}": rng.uniform(0.5, 1.5), f"rb_{side}": rng.uniform(0.5, 1.5), f"rc_{side}": rng.uniform(0.5, 1.5),
+                        f"g1_{side}": 2, f"g2_{side}": 2, f"g3_{side}": 2})
+        f.write(",".join(str(row[c]) for c in cols) + "\n")
+PY
+"$bin" contact --pairs "$many" -o "$ARTICULA_TMP/many1.csv" --force -q --threads 1
+"$bin" contact --pairs "$many" -o "$ARTICULA_TMP/many2.csv" --force -q --threads 2 --json > "$ARTICULA_TMP/many2.json"
+cmp "$ARTICULA_TMP/many1.csv" "$ARTICULA_TMP/many2.csv" || { echo "two threads wrote another file"; exit 1; }
+grep -q '"threads": 2' "$ARTICULA_TMP/many2.json" || { echo "threads not reported"; exit 1; }
+grep -q '"valid_rows": 400' "$ARTICULA_TMP/many2.json" || { echo "expected 400 valid rows"; cat "$ARTICULA_TMP/many2.json"; exit 1; }
+
 # shape_b kinds (case-insensitive): a sphere or an ellipsoid may leave its
 # exponents empty; a sphere with unequal radii, an ellipsoid with exponent 3,
 # an unknown kind and a superellipsoid without exponents are invalid rows.
