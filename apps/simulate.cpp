@@ -1,6 +1,7 @@
 // `articula simulate -i SCENE.json -o DIR`: forward dynamics of rigid bodies
 // with articula's compliant contact on Simbody (lib/dynamics). Writes
-// trajectory.csv, contacts.csv, steps.csv and, last, summary.json (wall
+// trajectory.csv, contacts.csv, steps.csv, their figures and, last,
+// summary.json (wall
 // time, integrator steps, contact evaluations, energies, provenance): a
 // folder without summary.json is unfinished.
 #include <cmath>
@@ -33,7 +34,8 @@ class SimulateCommand : public cli::Command {
   }
   int run(const cli::CommonOptions& common) override {
     const fs::path summary_path = output_ / "summary.json";
-    refuseOutputsOverInputs({output_ / "trajectory.csv", output_ / "contacts.csv", output_ / "steps.csv", summary_path},
+    refuseOutputsOverInputs({output_ / "trajectory.csv", output_ / "contacts.csv", output_ / "steps.csv",
+                             output_ / "trajectory.svg", output_ / "contact_forces.svg", output_ / "steps.svg", summary_path},
                             {scene_path_});
     if (!common.force && fs::exists(summary_path))
       throw UsageError("refusing to overwrite " + summary_path.string() + " (use --force)");
@@ -52,7 +54,7 @@ class SimulateCommand : public cli::Command {
     });
     nlohmann::json summary = s.toJson();
     summary["scene"] = scene_path_.string();
-    summary["outputs"] = {"trajectory.csv", "contacts.csv", "steps.csv"};
+    summary["outputs"] = {"trajectory.csv", "contacts.csv", "steps.csv", "trajectory.svg", "contact_forces.svg", "steps.svg"};
     summary["provenance"] = provenanceJson({{{"scene", scene.source}}, {scene_path_}, -1});
     summary["provenance"]["coordinate_system"] = "the scene's (z up when gravity is -z)";
     summary["provenance"]["units"] = "SI: m, kg, s, N";

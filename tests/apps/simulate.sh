@@ -35,6 +35,10 @@ steps = list(csv.DictReader(open(f"{out}/steps.csv")))
 assert len(steps) == summary["steps"], (len(steps), summary["steps"])
 contacts = list(csv.DictReader(open(f"{out}/contacts.csv")))
 assert len(contacts) > 150 and all(float(c["normal_n"]) > 0 for c in contacts)
+for figure in ("trajectory.svg", "contact_forces.svg", "steps.svg"):
+    svg = open(f"{out}/{figure}").read()
+    assert svg.startswith("<svg") and svg.rstrip().endswith("</svg>") and "<polyline" in svg, figure
+    assert figure in summary["outputs"], summary["outputs"]
 PY
 
 # The spinning ellipsoid on a plane touches it.

@@ -5,6 +5,7 @@
 #include <random>
 #include <map>
 #include <regex>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include "articula/report/diverging_colour.hpp"
 #include "articula/report/error_map_svg.hpp"
 #include "articula/report/error_statistics.hpp"
+#include "articula/report/line_chart_svg.hpp"
 #include "articula/report/histogram_svg.hpp"
 #include "articula/report/ply_writers.hpp"
 #include "articula/report/study_svg.hpp"
@@ -226,6 +228,43 @@ TEST(PlyWriters, ColoursFollowTheBand) {
 TEST(SummaryCsv, HeaderMatchesTheContract) {
   const std::string csv = summaryCsv({});
   EXPECT_EQ(csv, "model,n_points,min_mm,max_mm,mean_abs_mm,std_abs_mm,rms_mm,gauss_mu_mm,gauss_sigma_mm,sse_mm2\n");
+}
+
+// Line charts: the points land where the axes put them (linear and log),
+// a NaN breaks a line in two, and mismatched series are refused.
+TEST(LineChart, PointsFollowTheAxesAndNaNBreaksTheLine) {
+  const auto polylines = [](const std::string& svg) {
+    std::vector<std::vector<std::pair<double, double>>> lines;
+    const std::regex polyline("points=\"([^\"]*)\"");
+    for (auto it = std::sregex_iterator(svg.begin(), svg.end(), polyline); it != std::sregex_iterator(); ++it) {
+      std::vector<std::pair<double, double>> line;
+      std::istringstream in((*it)[1].str());
+      std::string pair;
+      while (in >> pair) {
+        const auto comma = pair.find(',');
+        line.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
+      }
+      lines.push_back(line);
+    }
+    return lines;
+  };
+  const std::string linear = articula::report::lineChartSvg({{"z", {0, 1, 2, 3}, {0, 1, NAN, 3}}}, {"t", "time (s)", "z (m)"});
+  const auto lines = polylines(linear);
+  ASSERT_EQ(lines.size(), 2u);
+  ASSERT_EQ(lines[0].size(), 2u);
+  ASSERT_EQ(lines[1].size(), 1u);
+  // Equal steps in x and y are equal steps on the page (y grows upwards).
+  const double dx = lines[0][1].first - lines[0][0].first, dy = lines[0][0].second - lines[0][1].second;
+  EXPECT_NEAR(lines[1][0].first - lines[0][0].first, 3 * dx, 0.01);  // page units, 6 digits
+  EXPECT_NEAR(lines[0][0].second - lines[1][0].second, 3 * dy, 0.01);
+  EXPECT_GT(dy, 0);
+  EXPECT_NE(linear.find("time (s)"), std::string::npos);
+  // Log scale: 1e-4, 1e-3, 1e-2 are equally spaced.
+  articula::report::LineChart log_chart{"steps", "time (s)", "step (s)", true};
+  const auto log_lines = polylines(articula::report::lineChartSvg({{"h", {0, 1, 2}, {1e-4, 1e-3, 1e-2}}}, log_chart));
+  ASSERT_EQ(log_lines.size(), 1u);
+  EXPECT_NEAR(log_lines[0][0].second - log_lines[0][1].second, log_lines[0][1].second - log_lines[0][2].second, 0.01);
+  EXPECT_THROW(articula::report::lineChartSvg({{"bad", {0, 1}, {0}}}, {}), articula::InvalidParameter);
 }
 
 }  // namespace

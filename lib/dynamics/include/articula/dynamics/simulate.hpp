@@ -3,8 +3,9 @@
 // writes, into a folder: trajectory.csv (every body's position, orientation
 // quaternion, velocities, and the system's energies, at each output time),
 // contacts.csv (each contact's depth, normal and friction forces and point),
-// steps.csv (every internal integrator step) and nothing else; the summary
-// is returned for the caller to write with its provenance.
+// steps.csv (every internal integrator step) and their figures
+// (trajectory.svg: heights; contact_forces.svg; steps.svg); the summary is
+// returned for the caller to write with its provenance.
 #include <filesystem>
 #include <functional>
 
