@@ -10,13 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/number_text.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/pipeline/stages.hpp"
@@ -40,10 +40,9 @@ std::string hashInput(const fs::path& path) {
 }
 
 std::string number(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
+  std::string text;
+  appendNumber(text, v, 10);
+  return text;
 }
 
 class RunCommand : public cli::Command {

@@ -34,9 +34,9 @@ class SimulateCommand : public cli::Command {
   }
   int run(const cli::CommonOptions& common) override {
     const fs::path summary_path = output_ / "summary.json";
-    refuseOutputsOverInputs({output_ / "trajectory.csv", output_ / "contacts.csv", output_ / "steps.csv",
-                             output_ / "trajectory.svg", output_ / "contact_forces.svg", output_ / "steps.svg", summary_path},
-                            {scene_path_});
+    std::vector<fs::path> outputs = {summary_path};
+    for (const std::string& name : dynamics::simulationOutputs()) outputs.push_back(output_ / name);
+    refuseOutputsOverInputs(outputs, {scene_path_});
     if (!common.force && fs::exists(summary_path))
       throw UsageError("refusing to overwrite " + summary_path.string() + " (use --force)");
     const dynamics::Scene scene = dynamics::readScene(scene_path_);
@@ -54,7 +54,7 @@ class SimulateCommand : public cli::Command {
     });
     nlohmann::json summary = s.toJson();
     summary["scene"] = scene_path_.string();
-    summary["outputs"] = {"trajectory.csv", "contacts.csv", "steps.csv", "trajectory.svg", "contact_forces.svg", "steps.svg"};
+    summary["outputs"] = dynamics::simulationOutputs();
     summary["provenance"] = provenanceJson({{{"scene", scene.source}}, {scene_path_}, -1});
     summary["provenance"]["coordinate_system"] = "the scene's (z up when gravity is -z)";
     summary["provenance"]["units"] = "SI: m, kg, s, N";

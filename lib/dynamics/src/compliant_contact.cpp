@@ -55,19 +55,23 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
   std::vector<Pair> pairs;
   mutable ContactCounters counters;
 
-  // The contact of pair p at `state`: A is the moving body, B the ground.
-  // stateOf fills `station` (and `station_b` for a shape pair): where the force acts, in each body's frame.
-  mutable SimTK::Vec3 station_b;
+  // A pair's contact and where its force acts, in each body's frame.
+  struct Evaluated {
+    contact::ContactState state;
+    SimTK::Vec3 station, station_b;  // station_b: shape pairs only
+  };
 
-  contact::ContactState stateOf(const Pair& p, const SimTK::State& state, SimTK::Vec3& station) const {
+  // The contact of pair p at `state`: A is the moving body, B the ground or,
+  // for a shape pair, the other body.
+  Evaluated evaluate(const Pair& p, const SimTK::State& state) const {
+    Evaluated e;
+    contact::ContactState& s = e.state;
     const SimTK::MobilizedBody& body = matter_.getMobilizedBody(p.body);
     const SimTK::Transform& X_GB = body.getBodyTransform(state);
-    contact::ContactState s;
     if (p.kind == PairKind::ShapePair) {
       const SimTK::Transform& X_GB2 = matter_.getMobilizedBody(p.body_b).getBodyTransform(state);
       const contact::ContactResult r = contact::computeContact(inGround(p.shape, X_GB), inGround(p.shape_b, X_GB2), {},
                                                                p.last ? &*p.last : nullptr);
-      if (p.last) ++counters.warm_starts;
       p.last = r;
       s.point_a = r.point_a;
       s.point_b = r.point_b;
@@ -91,28 +95,28 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
       s.depth = offset + p.radius - p.cavity_radius;
     }
     const Eigen::Vector3d at = 0.5 * (s.point_a + s.point_b);
-    station = X_GB.shiftBaseStationToFrame(toSimTK(at));
-    s.velocity_a = toEigen(body.findStationVelocityInGround(state, station));
+    e.station = X_GB.shiftBaseStationToFrame(toSimTK(at));
+    s.velocity_a = toEigen(body.findStationVelocityInGround(state, e.station));
     if (p.kind == PairKind::ShapePair) {
       const SimTK::MobilizedBody& b = matter_.getMobilizedBody(p.body_b);
-      station_b = b.getBodyTransform(state).shiftBaseStationToFrame(toSimTK(at));
-      s.velocity_b = toEigen(b.findStationVelocityInGround(state, station_b));
+      e.station_b = b.getBodyTransform(state).shiftBaseStationToFrame(toSimTK(at));
+      s.velocity_b = toEigen(b.findStationVelocityInGround(state, e.station_b));
     }
-    return s;
+    return e;
   }
 
   void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
                  SimTK::Vector&) const override {
     for (const Pair& p : pairs) {
-      SimTK::Vec3 station;
-      const contact::ContactState s = stateOf(p, state, station);
+      counters.warm_starts += p.kind == PairKind::ShapePair && p.last;
+      const Evaluated e = evaluate(p, state);
       ++counters.evaluations;
-      if (!(s.depth > 0)) continue;
+      if (!(e.state.depth > 0)) continue;
       ++counters.in_contact;
-      const contact::ContactForce f = contact::contactForce(s, p.laws.normal, p.laws.friction);
-      matter_.getMobilizedBody(p.body).applyForceToBodyPoint(state, station, toSimTK(-f.on_b), body_forces);
+      const contact::ContactForce f = contact::contactForce(e.state, p.laws.normal, p.laws.friction);
+      matter_.getMobilizedBody(p.body).applyForceToBodyPoint(state, e.station, toSimTK(-f.on_b), body_forces);
       if (p.kind == PairKind::ShapePair)
-        matter_.getMobilizedBody(p.body_b).applyForceToBodyPoint(state, station_b, toSimTK(f.on_b), body_forces);
+        matter_.getMobilizedBody(p.body_b).applyForceToBodyPoint(state, e.station_b, toSimTK(f.on_b), body_forces);
     }
   }
 
@@ -120,10 +124,8 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
   SimTK::Real calcPotentialEnergy(const SimTK::State& state) const override {
     double energy = 0;
     for (const Pair& p : pairs) {
-      SimTK::Vec3 station;
-      const contact::ContactState s = stateOf(p, state, station);
-      if (s.depth > 0)
-        energy += p.laws.normal.stiffness * std::pow(s.depth, p.laws.normal.exponent + 1) / (p.laws.normal.exponent + 1);
+      const double depth = evaluate(p, state).state.depth;
+      if (depth > 0) energy += p.laws.normal.stiffness * std::pow(depth, p.laws.normal.exponent + 1) / (p.laws.normal.exponent + 1);
     }
     return energy;
   }
@@ -197,11 +199,8 @@ const ContactCounters& CompliantContact::counters() const { return element_->cou
 
 std::vector<contact::ContactForce> CompliantContact::forces(const SimTK::State& state) const {
   std::vector<contact::ContactForce> out;
-  for (const Pair& p : element_->pairs) {
-    SimTK::Vec3 station;
-    const contact::ContactState s = element_->stateOf(p, state, station);
-    out.push_back(contact::contactForce(s, p.laws.normal, p.laws.friction));
-  }
+  for (const Pair& p : element_->pairs)
+    out.push_back(contact::contactForce(element_->evaluate(p, state).state, p.laws.normal, p.laws.friction));
   return out;
 }
 

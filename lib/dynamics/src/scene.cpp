@@ -143,10 +143,9 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   for (size_t i = 0; i < bodies.size(); ++i)
     if (bodies[i].name == body) c.body = static_cast<int>(i);
   if (c.body < 0) throw InputError(where + ": body \"" + excerpt(body) + "\" is not one of the scene's bodies");
-  const json& s = object(j, "shape", where);
-  const std::string model = text(s, "model", where + " shape", std::nullopt);
-  c.shape = readShape(s, where + " shape");
-  const Eigen::Vector3d radii = c.shape.radii, center = c.shape.center;
+  c.shape = readShape(object(j, "shape", where), where + " shape");
+  const bool centred_sphere = c.shape.quadric && c.shape.radii.minCoeff() == c.shape.radii.maxCoeff() &&
+                              c.shape.center == Eigen::Vector3d::Zero();
   const json& against = object(j, "against", where);
   if (const json* plane = member(against, "plane")) {
     const std::string pw = where + " against plane";
@@ -157,11 +156,11 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   } else if (const json* cavity = member(against, "cavity")) {
     const std::string cw = where + " against cavity";
     if (!cavity->is_object()) refuse(where, "against cavity", "an object", *cavity);
-    if (model != "sphere" || center != Eigen::Vector3d::Zero())
+    if (!centred_sphere)
       throw InputError(cw + ": a cavity holds a sphere centred at its body's origin (shape center [0, 0, 0])");
     c.cavity = true;
     c.point = vector3(*cavity, "center", cw, std::nullopt);
-    c.cavity_radius = number(*cavity, "radius", cw, std::nullopt, radii[0] * (1 + 1e-9), 1e6,
+    c.cavity_radius = number(*cavity, "radius", cw, std::nullopt, c.shape.radii[0] * (1 + 1e-9), 1e6,
                              "a radius larger than the sphere's");
   } else if (const json* other = member(against, "body")) {
     const std::string ow = where + " against";

@@ -9,6 +9,7 @@
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/number_text.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/report/line_chart_svg.hpp"
@@ -28,12 +29,18 @@ std::unique_ptr<SimTK::Integrator> makeIntegrator(IntegratorKind kind, const Sim
 }
 
 std::string csvNumber(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
+  std::string text;
+  appendNumber(text, v, 10);
+  return text;
 }
 
 }  // namespace
+
+const std::vector<std::string>& simulationOutputs() {
+  static const std::vector<std::string> names = {"trajectory.csv", "contacts.csv",       "steps.csv",
+                                                 "trajectory.svg", "contact_forces.svg", "steps.svg"};
+  return names;
+}
 
 nlohmann::json SimulationSummary::toJson() const {
   return {{"simulated_s", simulated_seconds}, {"wall_s", wall_seconds},       {"steps", steps},
@@ -157,15 +164,15 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
   summary.mean_step = summary.steps ? summary.simulated_seconds / static_cast<double>(summary.steps) : 0;
   if (summary.steps == 0) summary.min_step = 0;
   summary.contact_evaluations = contact.counters().evaluations;
-  writeFileAtomically(folder / "trajectory.csv", trajectory);
-  writeFileAtomically(folder / "contacts.csv", contacts);
-  writeFileAtomically(folder / "steps.csv", steps);
-  writeFileAtomically(folder / "trajectory.svg",
-                      report::lineChartSvg(heights, {"Height of each body along -gravity", "time (s)", "height (m)"}));
-  writeFileAtomically(folder / "contact_forces.svg",
-                      report::lineChartSvg(normal_forces, {"Normal contact force", "time (s)", "force (N)"}));
-  writeFileAtomically(folder / "steps.svg",
-                      report::lineChartSvg({step_sizes}, {"Integrator step sizes", "time (s)", "step (s)", true}));
+  // In the order of simulationOutputs().
+  const std::string contents[] = {
+      trajectory,
+      contacts,
+      steps,
+      report::lineChartSvg(heights, {"Height of each body along -gravity", "time (s)", "height (m)"}),
+      report::lineChartSvg(normal_forces, {"Normal contact force", "time (s)", "force (N)"}),
+      report::lineChartSvg({step_sizes}, {"Integrator step sizes", "time (s)", "step (s)", true})};
+  for (size_t i = 0; i < simulationOutputs().size(); ++i) writeFileAtomically(folder / simulationOutputs()[i], contents[i]);
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return summary;
 }

@@ -4,13 +4,13 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/number_text.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/fit/fits_json.hpp"
 #include "articula/geometry/pose.hpp"
@@ -27,10 +27,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 std::string number(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
+  std::string text;
+  appendNumber(text, v, 10);
+  return text;
 }
 
 // Parameter names with units, for results and study tables (angles in degrees).

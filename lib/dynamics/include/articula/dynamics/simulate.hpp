@@ -8,6 +8,8 @@
 // returned for the caller to write with its provenance.
 #include <filesystem>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -26,7 +28,10 @@ struct SimulationSummary {
   nlohmann::json toJson() const;
 };
 
-/// Simulates `scene` and writes the three tables into `folder` (which must
+/// The files simulateScene writes into its folder, in this order.
+const std::vector<std::string>& simulationOutputs();
+
+/// Simulates `scene` and writes the tables and figures into `folder` (which must
 /// exist); `progress(t)` is called at every output time.
 SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path& folder,
                                 const std::function<void(double)>& progress = {});
