@@ -57,6 +57,24 @@ assert max(abs(a - b) for a, b in zip(start, end)) < 1e-8, (start, end)
 assert float(rows[-1]["b_vx_m_s"]) > 0.1, "they never collided"
 PY
 
+# The three-segment foot, with surfaces and with points: it lands on its heel
+# and rolls to the toes (the heel leaves the ground while the hallux bears).
+for sole in surfaces points; do
+  expect_rc 0 "$bin/articula" simulate -i "$src/scenes/foot_$sole.json" -o "$tmp/foot-$sole" -q
+  python3 - "$tmp/foot-$sole/contacts.csv" "$sole" <<'PY'
+import csv, sys
+heel, hallux = ({0}, {5}) if sys.argv[2] == "surfaces" else (set(range(8)), set(range(26, 31)))
+rows = list(csv.DictReader(open(sys.argv[1])))
+times = sorted({float(r["time_s"]) for r in rows})
+touching = {t: set() for t in times}
+for r in rows:
+    touching[float(r["time_s"])].add(int(r["contact"]))
+first = lambda ids: min(t for t in times if touching[t] & ids)
+assert first(heel) < first(hallux), (first(heel), first(hallux))
+assert any(touching[t] & hallux and not touching[t] & heel for t in times), "the heel never left the ground"
+PY
+done
+
 # A second run refuses to overwrite; --force redoes it.
 expect_rc 2 "$bin/articula" simulate -i "$tmp/bowl.json" -o "$tmp/bowl"
 grep -q "refusing to overwrite" "$tmp/err" || fail "overwrite message: $(cat "$tmp/err")"
@@ -84,6 +102,10 @@ bad law 'scene["contacts"][0]["normal_law"]["law"] = "spring"' 'hertz, hunt-cros
 bad inertia 'scene["bodies"][0]["inertia"] = [1, 1, 5]' 'triangle inequality'
 bad rows 'scene["output_interval"] = 1e-9' 'more than 1e6 output rows'
 bad friction 'scene["contacts"][0]["friction"]["transition_speed"] = 0' 'transition_speed: expected a speed > 0'
+bad joint-parent 'scene["bodies"].append({"name": "arm", "mass": 1, "inertia": [1, 1, 1], "joint": {"parent": "leg", "point_in_parent": [0, 0, 0], "point_in_child": [0, 0, 0], "axis": [0, 1, 0]}})' 'parent "leg" is not a body listed before this one'
+bad hinged-position 'scene["bodies"].append({"name": "arm", "mass": 1, "inertia": [1, 1, 1], "position": [0, 0, 1], "joint": {"parent": "ball", "point_in_parent": [0, 0, 0], "point_in_child": [0, 0, 0], "axis": [0, 1, 0]}})' '"position" of a hinged body'
+bad joint-axis 'scene["bodies"].append({"name": "arm", "mass": 1, "inertia": [1, 1, 1], "joint": {"parent": "ball", "point_in_parent": [0, 0, 0], "point_in_child": [0, 0, 0], "axis": [0, 0, 0]}})' 'axis: expected a non-zero vector'
+bad point-in-cavity 'c = scene["contacts"][0]; del c["shape"]; c["point"] = [0, 0, -0.1]' 'a contact point meets a plane only'
 bad nan-position 'scene["bodies"][0]["position"] = [0.9, "x", 1]' 'position: expected three numbers'
 printf '[%.0s' $(seq 1 100000) > "$tmp/deep.json"
 expect_rc 3 "$bin/articula" simulate -i "$tmp/deep.json" -o "$tmp/out-deep"

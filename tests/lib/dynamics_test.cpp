@@ -3,8 +3,16 @@
 // no friction a bouncing ball keeps its energy; a ball rolling without slip
 // at the bottom of a spherical bowl oscillates with the period of the rigid
 // rolling solution; a sphere dropped with spin on a plane follows Simbody's
-// HuntCrossleyForce with the same parameters.
+// HuntCrossleyForce with the same parameters; an ellipsoid rests where
+// Simbody's elliptical Hertz contact puts it; a body hinged by a scene's
+// revolute joint oscillates with the torsion pendulum's period and keeps its
+// energy; a body on four contact points rests at their Hertz depth.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -14,6 +22,8 @@
 
 #include "articula/contact/convex_shape.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
+#include "articula/dynamics/scene.hpp"
+#include "articula/dynamics/simulate.hpp"
 #include "articula/testsupport/ball_world.hpp"
 
 namespace {
@@ -200,6 +210,129 @@ TEST(Dynamics, ASphereOnAPlaneFollowsSimbodysHuntCrossley) {
   }
   EXPECT_LT(worst, 1e-6) << "travelled " << travelled << " m";
   EXPECT_GT(travelled, 0.05);  // it rolled and slid, not just sat
+}
+
+// Simbody's CompliantContactSubsystem answers an ellipsoid on a half-space
+// with its elliptical Hertz generator; articula's element takes one
+// stiffness, here hertzStiffness at the pole's curvatures (Greenwood's
+// equivalent radius). Both drop an ellipsoid on the pole of its shortest
+// axis and let it settle: the depths agree to within the two Hertz
+// approximations' difference (0.2 % here).
+TEST(Dynamics, AnEllipsoidRestsWhereSimbodysEllipticalHertzPutsIt) {
+  const double m = 1.0, a = 0.06, b = 0.05, c = 0.04, e_surface = 1e7, dissipation = 5.0;  // on its shortest axis: stable
+  const SimTK::Vec3 moments(0.2 * m * (b * b + c * c), 0.2 * m * (a * a + c * c), 0.2 * m * (a * a + b * b));
+  const auto restingDepth = [&](bool ours) {
+    BallWorld w(m, moments);
+    SimTK::ContactTrackerSubsystem tracker(w.system);
+    SimTK::CompliantContactSubsystem compliant(w.system, tracker);
+    std::unique_ptr<CompliantContact> element;
+    if (ours) {
+      const double modulus = e_surface / std::pow(2.0, 1.5);  // Simbody's combination of two equal surfaces
+      const double stiffness = articula::contact::hertzStiffness(c / (a * a), c / (b * b), modulus);
+      element = std::make_unique<CompliantContact>(w.forces);
+      element->addShapeOnPlane(w.ball,
+                               articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                                                  Vector3d(a, b, c)),
+                               Vector3d::Zero(), Vector3d::UnitZ(),
+                               hertzLaws(stiffness, NormalLaw::HuntCrossley, dissipation, 0.0));
+    } else {
+      const SimTK::ContactMaterial material(e_surface, dissipation, 0, 0, 0);
+      w.ball.updBody().addContactSurface(SimTK::Transform(),
+                                         SimTK::ContactSurface(SimTK::ContactGeometry::Ellipsoid(SimTK::Vec3(a, b, c)), material));
+      // Simbody's half-space fills x > 0 of its frame: turned so that it fills z < 0.
+      w.matter.updGround().updBody().addContactSurface(
+          SimTK::Transform(SimTK::Rotation(0.5 * SimTK::Pi, SimTK::YAxis), SimTK::Vec3(0)),
+          SimTK::ContactSurface(SimTK::ContactGeometry::HalfSpace(), material));
+    }
+    SimTK::State state = w.start();
+    w.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, c + 0.001));
+    Simulation run(w.system, state, 1e-9);
+    return c - w.ball.getBodyOriginLocation(run.stepTo(2.0))[2];
+  };
+  const double ours = restingDepth(true), simbody = restingDepth(false);
+  EXPECT_GT(ours, 0);
+  EXPECT_NEAR(ours, simbody, 0.01 * simbody) << "ours " << ours << " m, Simbody's " << simbody << " m";
+}
+
+/// The columns of a CSV file with a header, by name.
+std::map<std::string, std::vector<double>> readColumns(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  for (std::stringstream header(line); std::getline(header, line, ',');) names.push_back(line);
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    for (const std::string& name : names) {
+      std::string cell;
+      std::getline(row, cell, ',');
+      columns[name].push_back(std::stod(cell));
+    }
+  }
+  return columns;
+}
+
+std::filesystem::path simulateInto(const std::string& scene_json, const std::string& name) {
+  const std::filesystem::path folder = std::filesystem::path(::testing::TempDir()) / name;
+  std::filesystem::create_directories(folder);
+  articula::dynamics::simulateScene(articula::dynamics::sceneFromJson(nlohmann::json::parse(scene_json), name), folder);
+  return folder;
+}
+
+// No gravity; an arm hinged to a base a billion times heavier by an oblique
+// revolute joint with a torsion spring: theta'' = -k / (I + m L^2) theta,
+// exactly, so its centre swings with period 2 pi sqrt((I + m L^2) / k) in the
+// plane across the axis, and the energy (the spring's included) stays.
+TEST(Dynamics, AHingedArmSwingsWithTheTorsionPendulumsPeriod) {
+  const double m = 2, inertia = 0.01, arm = 0.2, k = 5;
+  const std::string scene = R"({
+    "gravity": [0, 0, 0], "duration": 3, "output_interval": 0.001,
+    "integrator": {"type": "runge-kutta-merson", "accuracy": 1e-9},
+    "bodies": [
+      {"name": "base", "mass": 1e9, "inertia": [1e9, 1e9, 1e9]},
+      {"name": "arm", "mass": 2, "inertia": [0.01, 0.01, 0.01],
+       "joint": {"type": "revolute", "parent": "base", "point_in_parent": [0, 0, 0], "point_in_child": [-0.2, 0, 0],
+                 "axis": [0, 1, 1], "stiffness": 5, "angle_deg": 10}}]})";
+  const auto columns = readColumns(simulateInto(scene, "hinged_arm") / "trajectory.csv");
+  // The arm's centre along the swing's tangent at rest, (axis x x) / |...|: proportional to sin(theta).
+  const Vector3d tangent = Vector3d(0, 1, 1).normalized().cross(Vector3d::UnitX());
+  const auto& t = columns.at("time_s");
+  std::vector<double> crossings;
+  double previous = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double s = tangent.dot(Vector3d(columns.at("arm_x_m")[i], columns.at("arm_y_m")[i], columns.at("arm_z_m")[i]));
+    if (i > 0 && (previous < 0) != (s < 0)) crossings.push_back(t[i - 1] + (t[i] - t[i - 1]) * previous / (previous - s));
+    previous = s;
+  }
+  ASSERT_GE(crossings.size(), 5u);
+  const double period = 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  const double expected = 2 * M_PI * std::sqrt((inertia + m * arm * arm) / k);
+  EXPECT_NEAR(period, expected, 1e-4 * expected);
+  const auto& energy = columns.at("total_j");
+  EXPECT_GT(energy.front(), 0);  // the spring's, at 10 degrees
+  EXPECT_NEAR(energy.back(), energy.front(), 1e-6 * energy.front());
+}
+
+// A box on four contact points at its bottom corners: each carries a quarter
+// of the weight, K d^1.5 = m g / 4.
+TEST(Dynamics, ABoxOnFourContactPointsRestsAtTheirHertzDepth) {
+  const double m = 2, K = 1e5, half_height = 0.05;
+  std::string contacts;
+  for (const char* corner : {"[0.1, 0.05, -0.05]", "[0.1, -0.05, -0.05]", "[-0.1, 0.05, -0.05]", "[-0.1, -0.05, -0.05]"})
+    contacts += std::string(contacts.empty() ? "" : ",") + R"({"body": "box", "point": )" + corner +
+                R"(, "against": {"plane": {"normal": [0, 0, 1]}},
+                "normal_law": {"law": "hunt-crossley", "stiffness": 1e5, "dissipation": 20},
+                "friction": {"dynamic": 0.5}})";
+  const std::string scene = R"({"duration": 3, "output_interval": 0.5,
+    "integrator": {"type": "runge-kutta-merson", "accuracy": 1e-10},
+    "bodies": [{"name": "box", "mass": 2, "inertia": [0.004, 0.008, 0.01], "position": [0, 0, 0.051]}],
+    "contacts": [)" + contacts + "]}";
+  const auto columns = readColumns(simulateInto(scene, "box_on_points") / "trajectory.csv");
+  const double depth = half_height - columns.at("box_z_m").back();
+  const double hertz = std::pow(m * kGravity / (4 * K), 2.0 / 3.0);
+  EXPECT_NEAR(depth, hertz, 1e-6 * hertz);
+  EXPECT_NEAR(columns.at("box_x_m").back(), 0, 1e-9);  // symmetric: no drift
 }
 
 }  // namespace

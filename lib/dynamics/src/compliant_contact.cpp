@@ -21,13 +21,14 @@ Eigen::Matrix3d toEigen(const SimTK::Rotation& r) {
   return m;
 }
 
-enum class PairKind { ShapeOnPlane, SphereInCavity, ShapePair };
+enum class PairKind { ShapeOnPlane, PointOnPlane, SphereInCavity, ShapePair };
 
 struct Pair {
   PairKind kind = PairKind::ShapeOnPlane;
   SimTK::MobilizedBodyIndex body;
   contact::ConvexShape shape;                  // ShapeOnPlane, ShapePair (A): in the body's frame
   double radius = 0, cavity_radius = 0;        // SphereInCavity
+  Eigen::Vector3d station = Eigen::Vector3d::Zero();  // PointOnPlane: in the body's frame
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // plane, or cavity centre
   ContactLaws laws;
   SimTK::MobilizedBodyIndex body_b;            // ShapePair: B and its shape in its frame
@@ -83,6 +84,11 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
       s.point_b = r.point_b;
       s.normal = r.normal;  // outward of the shape: towards the plane's solid
       s.depth = -r.distance;
+    } else if (p.kind == PairKind::PointOnPlane) {
+      s.point_a = toEigen(X_GB * toSimTK(p.station));
+      s.depth = p.normal.dot(p.point - s.point_a);
+      s.point_b = s.point_a + s.depth * p.normal;
+      s.normal = -p.normal;  // into the plane's solid, as for a shape
     } else {
       const Eigen::Vector3d center = toEigen(X_GB.p());
       Eigen::Vector3d u = center - p.point;
@@ -154,6 +160,24 @@ void CompliantContact::addShapeOnPlane(const SimTK::MobilizedBody& body, const c
   p.kind = PairKind::ShapeOnPlane;
   p.body = body.getMobilizedBodyIndex();
   p.shape = shape;
+  p.point = plane_point;
+  p.normal = plane_normal.normalized();
+  p.laws = laws;
+  element_->pairs.push_back(p);
+}
+
+void CompliantContact::addPointOnPlane(const SimTK::MobilizedBody& body, const Eigen::Vector3d& station,
+                                       const Eigen::Vector3d& plane_point, const Eigen::Vector3d& plane_normal,
+                                       const ContactLaws& laws) {
+  laws.normal.validate();
+  laws.friction.validate();
+  if (!(plane_normal.allFinite() && plane_normal.norm() > 0 && plane_point.allFinite()))
+    throw InvalidParameter("contact plane normal", "a finite non-zero vector", plane_normal.norm());
+  if (!station.allFinite()) throw InvalidParameter("contact point", "finite coordinates", station.norm());
+  Pair p;
+  p.kind = PairKind::PointOnPlane;
+  p.body = body.getMobilizedBodyIndex();
+  p.station = station;
   p.point = plane_point;
   p.normal = plane_normal.normalized();
   p.laws = laws;

@@ -70,7 +70,34 @@ const json& object(const json& parent, const char* key, const std::string& where
   return *v;
 }
 
-SceneBody readBody(const json& j, const std::string& where) {
+int bodyIndex(const std::string& name, const std::vector<SceneBody>& bodies) {
+  for (size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+SceneJoint readJoint(const json& j, const std::string& where, const std::vector<SceneBody>& earlier) {
+  if (!j.is_object()) refuse(where, "joint", "an object", j);
+  SceneJoint joint;
+  if (text(j, "type", where, "revolute") != "revolute") refuse(where, "type", "revolute", j.at("type"));
+  const std::string parent = text(j, "parent", where, std::nullopt);
+  joint.parent = bodyIndex(parent, earlier);
+  if (joint.parent < 0)
+    throw InputError(where + ": parent \"" + excerpt(parent) + "\" is not a body listed before this one");
+  joint.point_in_parent = vector3(j, "point_in_parent", where, std::nullopt, 1e3);
+  joint.point_in_child = vector3(j, "point_in_child", where, std::nullopt, 1e3);
+  joint.axis = vector3(j, "axis", where, std::nullopt);
+  if (!(joint.axis.norm() > 0)) refuse(where, "axis", "a non-zero vector", j.at("axis"));
+  joint.axis.normalize();
+  joint.stiffness = number(j, "stiffness", where, 0.0, 0, 1e9, "a stiffness >= 0 (N m/rad)");
+  joint.damping = number(j, "damping", where, 0.0, 0, 1e9, "a damping >= 0 (N m s/rad)");
+  joint.rest_angle_deg = number(j, "rest_angle_deg", where, 0.0, -360, 360, "an angle of -360 to 360 degrees");
+  joint.angle_deg = number(j, "angle_deg", where, 0.0, -360, 360, "an angle of -360 to 360 degrees");
+  joint.rate_deg_s = number(j, "rate_deg_s", where, 0.0, -1e6, 1e6, "a rate within +-1e6 degrees/s");
+  return joint;
+}
+
+SceneBody readBody(const json& j, const std::string& where, const std::vector<SceneBody>& earlier) {
   if (!j.is_object()) refuse(where, "body", "an object", j);
   SceneBody b;
   b.name = text(j, "name", where, std::nullopt);
@@ -79,6 +106,14 @@ SceneBody readBody(const json& j, const std::string& where) {
   const Eigen::Vector3d& I = b.inertia;
   if (!(I.minCoeff() > 0) || I[0] + I[1] < I[2] || I[1] + I[2] < I[0] || I[0] + I[2] < I[1])
     refuse(where, "inertia", "principal moments > 0 that satisfy the triangle inequality", j.at("inertia"));
+  if (const json* joint = member(j, "joint")) {
+    b.joint = readJoint(*joint, where + " joint", earlier);
+    for (const char* key : {"position", "angles_deg", "velocity", "angular_velocity"})
+      if (member(j, key))
+        throw InputError(where + ": \"" + key + "\" of a hinged body: its pose and velocity follow from its parent "
+                         "and the joint's angle_deg and rate_deg_s");
+    return b;
+  }
   b.position = vector3(j, "position", where, Eigen::Vector3d::Zero());
   b.angles_deg = vector3(j, "angles_deg", where, Eigen::Vector3d::Zero(), 3600);
   b.velocity = vector3(j, "velocity", where, Eigen::Vector3d::Zero(), 1e4);
@@ -139,11 +174,12 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   if (!j.is_object()) refuse(where, "contact", "an object", j);
   SceneContact c;
   const std::string body = text(j, "body", where, std::nullopt);
-  c.body = -1;
-  for (size_t i = 0; i < bodies.size(); ++i)
-    if (bodies[i].name == body) c.body = static_cast<int>(i);
+  c.body = bodyIndex(body, bodies);
   if (c.body < 0) throw InputError(where + ": body \"" + excerpt(body) + "\" is not one of the scene's bodies");
-  c.shape = readShape(object(j, "shape", where), where + " shape");
+  if (member(j, "point") && member(j, "shape")) throw InputError(where + ": either \"shape\" or \"point\", not both");
+  c.point_contact = member(j, "point") != nullptr;
+  if (c.point_contact) c.station = vector3(j, "point", where, std::nullopt, 1e3);
+  else c.shape = readShape(object(j, "shape", where), where + " shape");
   const bool centred_sphere = c.shape.quadric && c.shape.radii.minCoeff() == c.shape.radii.maxCoeff() &&
                               c.shape.center == Eigen::Vector3d::Zero();
   const json& against = object(j, "against", where);
@@ -153,6 +189,9 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
     c.point = vector3(*plane, "point", pw, Eigen::Vector3d::Zero());
     c.normal = vector3(*plane, "normal", pw, std::nullopt);
     if (!(c.normal.norm() > 0)) refuse(pw, "normal", "a non-zero vector", plane->at("normal"));
+  } else if (c.point_contact) {
+    throw InputError(where + ": against: a contact point meets a plane only ({\"plane\": ...}), found " +
+                     describeJson(against));
   } else if (const json* cavity = member(against, "cavity")) {
     const std::string cw = where + " against cavity";
     if (!cavity->is_object()) refuse(where, "against cavity", "an object", *cavity);
@@ -165,8 +204,7 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   } else if (const json* other = member(against, "body")) {
     const std::string ow = where + " against";
     if (!other->is_string()) refuse(ow, "body", "a body's name", *other);
-    for (size_t i = 0; i < bodies.size(); ++i)
-      if (bodies[i].name == other->get<std::string>()) c.other_body = static_cast<int>(i);
+    c.other_body = bodyIndex(other->get<std::string>(), bodies);
     if (c.other_body < 0 || c.other_body == c.body)
       throw InputError(ow + ": body \"" + excerpt(other->get<std::string>()) + "\" is not another of the scene's bodies");
     c.other_shape = readShape(object(against, "shape", ow), ow + " shape");
@@ -210,7 +248,7 @@ Scene sceneFromJson(const json& document, const std::string& where) {
     throw InputError(where + ": bodies: expected an array of 1 to 1000 bodies, found " +
                      (bodies ? describeJson(*bodies) : std::string("nothing")));
   for (size_t i = 0; i < bodies->size(); ++i) {
-    scene.bodies.push_back(readBody((*bodies)[i], where + " bodies[" + std::to_string(i) + "]"));
+    scene.bodies.push_back(readBody((*bodies)[i], where + " bodies[" + std::to_string(i) + "]", scene.bodies));
     for (size_t k = 0; k < i; ++k)
       if (scene.bodies[k].name == scene.bodies[i].name)
         throw InputError(where + ": bodies[" + std::to_string(i) + "]: the name \"" + excerpt(scene.bodies[i].name) +

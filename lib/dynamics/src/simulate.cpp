@@ -57,26 +57,49 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
   SimTK::GeneralForceSubsystem forces(system);
   const double g = scene.gravity.norm();
   if (g > 0) SimTK::Force::Gravity(forces, matter, SimTK::UnitVec3(toSimTK(scene.gravity / g)), g);
-  std::vector<SimTK::MobilizedBody::Free> bodies;
+  std::vector<SimTK::MobilizedBody> bodies;
+  std::vector<bool> hinged;
   for (const SceneBody& b : scene.bodies) {
-    SimTK::Inertia inertia(toSimTK(b.inertia));
-    bodies.emplace_back(matter.Ground(), SimTK::Transform(),
-                        SimTK::Body::Rigid(SimTK::MassProperties(b.mass, SimTK::Vec3(0), inertia)), SimTK::Transform());
+    const SimTK::Body::Rigid body(SimTK::MassProperties(b.mass, SimTK::Vec3(0), SimTK::Inertia(toSimTK(b.inertia))));
+    const SceneJoint& j = b.joint;
+    hinged.push_back(j.parent >= 0);
+    if (j.parent < 0) {
+      bodies.push_back(SimTK::MobilizedBody::Free(matter.Ground(), SimTK::Transform(), body, SimTK::Transform()));
+      continue;
+    }
+    // Simbody's pin turns about the common z axis of its two frames.
+    const SimTK::Rotation z_along_axis(SimTK::UnitVec3(toSimTK(j.axis)), SimTK::ZAxis);
+    SimTK::MobilizedBody::Pin pin(bodies[static_cast<size_t>(j.parent)], SimTK::Transform(z_along_axis, toSimTK(j.point_in_parent)),
+                                  body, SimTK::Transform(z_along_axis, toSimTK(j.point_in_child)));
+    const double degree = M_PI / 180.0;
+    if (j.stiffness > 0)
+      SimTK::Force::MobilityLinearSpring(forces, pin, SimTK::MobilizerQIndex(0), j.stiffness, j.rest_angle_deg * degree);
+    if (j.damping > 0) SimTK::Force::MobilityLinearDamper(forces, pin, SimTK::MobilizerUIndex(0), j.damping);
+    bodies.push_back(pin);
   }
   CompliantContact contact(forces);
   for (const SceneContact& c : scene.contacts) {
+    const SimTK::MobilizedBody& body = bodies[static_cast<size_t>(c.body)];
     if (c.other_body >= 0)
-      contact.addShapePair(bodies[static_cast<size_t>(c.body)], c.shape, bodies[static_cast<size_t>(c.other_body)],
-                           c.other_shape, c.laws);
+      contact.addShapePair(body, c.shape, bodies[static_cast<size_t>(c.other_body)], c.other_shape, c.laws);
     else if (c.cavity)
-      contact.addSphereInCavity(bodies[static_cast<size_t>(c.body)], c.shape.radii[0], c.point, c.cavity_radius, c.laws);
+      contact.addSphereInCavity(body, c.shape.radii[0], c.point, c.cavity_radius, c.laws);
+    else if (c.point_contact)
+      contact.addPointOnPlane(body, c.station, c.point, c.normal, c.laws);
     else
-      contact.addShapeOnPlane(bodies[static_cast<size_t>(c.body)], c.shape, c.point, c.normal, c.laws);
+      contact.addShapeOnPlane(body, c.shape, c.point, c.normal, c.laws);
   }
   system.realizeTopology();
   SimTK::State state = system.getDefaultState();
+  // Parents before children (the scene's order): a hinged body's pose follows its parent's.
   for (size_t i = 0; i < bodies.size(); ++i) {
     const SceneBody& b = scene.bodies[i];
+    if (hinged[i]) {
+      const double degree = M_PI / 180.0;
+      bodies[i].setOneQ(state, SimTK::MobilizerQIndex(0), b.joint.angle_deg * degree);
+      bodies[i].setOneU(state, SimTK::MobilizerUIndex(0), b.joint.rate_deg_s * degree);
+      continue;
+    }
     const Eigen::Matrix3d R = geometry::rotationFromAngles(b.angles_deg * M_PI / 180.0);
     const SimTK::Mat33 m(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2));
     bodies[i].setQToFitTransform(state, SimTK::Transform(SimTK::Rotation(m, true), toSimTK(b.position)));
@@ -109,7 +132,7 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
     system.realize(s, SimTK::Stage::Dynamics);
     trajectory += csvNumber(s.getTime());
     for (size_t i = 0; i < bodies.size(); ++i) {
-      const SimTK::MobilizedBody::Free& body = bodies[i];
+      const SimTK::MobilizedBody& body = bodies[i];
       const SimTK::Transform& X = body.getBodyTransform(s);
       heights[i].x.push_back(s.getTime());
       heights[i].y.push_back(up.dot(Eigen::Vector3d(X.p()[0], X.p()[1], X.p()[2])));

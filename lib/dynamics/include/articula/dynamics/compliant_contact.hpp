@@ -5,9 +5,10 @@
 // at the contact points. Pairs: a convex shape (sphere, ellipsoid,
 // superellipsoid) on a body against a plane fixed in ground (the closed form
 // of thesis section 5.3), a sphere inside a spherical cavity fixed in ground
-// (conformal contact, thesis section 5.2.7), and two convex shapes on any
-// two bodies (the common-normal / dual solver, warm-started per pair). SI
-// units.
+// (conformal contact, thesis section 5.2.7), two convex shapes on any two
+// bodies (the common-normal / dual solver, warm-started per pair), and a
+// point on a body against a plane (the point elements of foot-ground
+// models, thesis ch. 6). SI units.
 #include <memory>
 
 #include <Simbody.h>
@@ -41,6 +42,12 @@ class CompliantContact {
   /// against the plane through `plane_point` with outward normal
   /// `plane_normal` (ground frame; the solid lies on the other side).
   void addShapeOnPlane(const SimTK::MobilizedBody& body, const contact::ConvexShape& shape,
+                       const Eigen::Vector3d& plane_point, const Eigen::Vector3d& plane_normal, const ContactLaws& laws);
+
+  /// The point `station` (the body's frame) against the plane through
+  /// `plane_point` with outward normal `plane_normal` (ground): depth is how
+  /// far the point lies beyond the plane.
+  void addPointOnPlane(const SimTK::MobilizedBody& body, const Eigen::Vector3d& station,
                        const Eigen::Vector3d& plane_point, const Eigen::Vector3d& plane_normal, const ContactLaws& laws);
 
   /// A ball of `radius` centred at the body's origin inside a spherical

@@ -1,9 +1,11 @@
 #pragma once
-// A simulation scene as `articula simulate` reads it (docs/formats.md): free
-// rigid bodies under gravity, each with contact surfaces (sphere, ellipsoid,
-// superellipsoid in the thesis form) against a plane or inside a spherical
-// cavity fixed in ground, or against another body's surface; the contact
-// laws, the integrator and the output.
+// A simulation scene as `articula simulate` reads it (docs/formats.md): rigid
+// bodies under gravity, free or hinged to a parent body by a revolute joint
+// with passive stiffness and damping, each with contact surfaces (sphere,
+// ellipsoid, superellipsoid in the thesis form) against a plane or inside a
+// spherical cavity fixed in ground, or against another body's surface, or
+// contact points against a plane (the point elements surfaces are compared
+// with); the contact laws, the integrator and the output.
 // SI units; angles in degrees in the file.
 #include <filesystem>
 #include <string>
@@ -17,8 +19,23 @@
 
 namespace articula::dynamics {
 
+/// A revolute joint to a parent body, given in both bodies' frames: at
+/// angle 0 the child's frame is the parent's turned by nothing and shifted
+/// so that the two joint points coincide.
+struct SceneJoint {
+  int parent = -1;  // index into Scene::bodies (an earlier body); -1: the body is free
+  Eigen::Vector3d point_in_parent = Eigen::Vector3d::Zero(), point_in_child = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitY();  // unit, in the parent's (and at angle 0 the child's) frame
+  double stiffness = 0;      // N m / rad, towards rest_angle
+  double damping = 0;        // N m s / rad
+  double rest_angle_deg = 0;
+  double angle_deg = 0;      // initial angle
+  double rate_deg_s = 0;     // initial rate
+};
+
 struct SceneBody {
   std::string name;
+  SceneJoint joint;  // a hinged body takes its pose and velocity from its parent and the joint
   double mass = 1;
   Eigen::Vector3d inertia = Eigen::Vector3d::Ones();  // principal moments about the centre of mass (body axes), kg m^2
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
@@ -30,6 +47,8 @@ struct SceneBody {
 struct SceneContact {
   int body = 0;                         // index into Scene::bodies
   contact::ConvexShape shape;           // in the body's frame
+  bool point_contact = false;           // a contact point (at `station`) against a plane, not a shape
+  Eigen::Vector3d station = Eigen::Vector3d::Zero();  // the point, in the body's frame
   bool cavity = false;                  // against a spherical cavity
   int other_body = -1;                  // against another body's shape (>= 0), else a plane or a cavity
   contact::ConvexShape other_shape;     // in that body's frame

@@ -15,9 +15,12 @@ struct BallWorld {
   SimTK::Force::Gravity gravity{forces, matter, -SimTK::ZAxis, kGravity};
   SimTK::MobilizedBody::Free ball;
 
-  BallWorld(double mass, double inertia)
+  BallWorld(double mass, double inertia) : BallWorld(mass, SimTK::Vec3(inertia)) {}
+
+  /// A body of any principal moments (an ellipsoid's, say) about its body axes.
+  BallWorld(double mass, const SimTK::Vec3& principal_moments)
       : ball(matter.Ground(), SimTK::Transform(),
-             SimTK::Body::Rigid(SimTK::MassProperties(mass, SimTK::Vec3(0), SimTK::UnitInertia(inertia / mass))),
+             SimTK::Body::Rigid(SimTK::MassProperties(mass, SimTK::Vec3(0), SimTK::Inertia(principal_moments))),
              SimTK::Transform()) {}
 
   /// The default state once every force is added.
