@@ -3,16 +3,25 @@
 // the same run (a sphere dropped with spin on a plane: it rolls and slides,
 // 1 s simulated), and the thesis's ball in a bowl (section 5.2.7: m = 1 kg,
 // r = 0.1 m, I = 0.01 kg m^2, R = 1 m, K = 140e6 N/m^1.5, restitution 0.9,
-// Coulomb friction 0.01), 10 s simulated. Runge-Kutta-Merson at accuracy
-// 1e-6. Counters: integrator steps, mean step (s), contact evaluations.
+// Coulomb friction 0.01), 10 s simulated; an ellipsoid dropped with spin on
+// a plane against Simbody's CompliantContactSubsystem (its elliptical Hertz
+// generator); the three-segment foot of scenes/ with 6 surface elements
+// against 31 point elements (the thesis's table 6.1), read and run as
+// `articula simulate` does. Runge-Kutta-Merson at accuracy 1e-6 (the foot:
+// the argument's 1e-4 or 1e-5). Counters: integrator steps, mean (and
+// minimum) step (s), contact evaluations.
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <string>
 
 #include <benchmark/benchmark.h>
 #include <Simbody.h>
 
 #include "articula/contact/convex_shape.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
+#include "articula/dynamics/scene.hpp"
+#include "articula/dynamics/simulate.hpp"
 #include "articula/testsupport/ball_world.hpp"
 
 namespace {
@@ -123,6 +132,88 @@ void BM_BallInBowl_Thesis(benchmark::State& state) {
   report(state, run);
 }
 BENCHMARK(BM_BallInBowl_Thesis)->Unit(benchmark::kMillisecond);
+
+// An ellipsoid (semi-axes 6, 5 and 4 cm) dropped on its shortest axis with
+// spin and forward speed: it bounces, rolls and slides. articula's element
+// takes the Hertz stiffness of the pole's curvatures; Simbody's generator
+// recomputes it from the curvatures at each contact.
+constexpr double kEggMass = 1.0, kEggA = 0.06, kEggB = 0.05, kEggC = 0.04;
+
+SimTK::Vec3 eggMoments() {
+  return {0.2 * kEggMass * (kEggB * kEggB + kEggC * kEggC), 0.2 * kEggMass * (kEggA * kEggA + kEggC * kEggC),
+          0.2 * kEggMass * (kEggA * kEggA + kEggB * kEggB)};
+}
+
+SimTK::State eggStart(Scene& scene) {
+  SimTK::State state = scene.start();
+  scene.ball.setQToFitTranslation(state, SimTK::Vec3(0, 0, kEggC + 0.01));
+  scene.ball.setUToFitVelocity(state, SimTK::SpatialVec(SimTK::Vec3(2, 5, 10), SimTK::Vec3(1.0, 0.2, 0)));
+  return state;
+}
+
+void BM_EllipsoidOnPlane_Articula(benchmark::State& state) {
+  Run run;
+  for (auto _ : state) {
+    Scene scene(kEggMass, eggMoments());
+    ContactLaws laws;
+    laws.normal.law = articula::contact::NormalLaw::HuntCrossley;
+    laws.normal.stiffness = articula::contact::hertzStiffness(kEggC / (kEggA * kEggA), kEggC / (kEggB * kEggB),
+                                                              kSurfaceModulus / std::pow(2.0, 1.5));
+    laws.normal.dissipation = kDissipation;
+    laws.friction.dynamic = kDynamic;
+    laws.friction.static_peak = kStatic;
+    laws.friction.transition_speed = kTransition;
+    scene.contact = std::make_unique<CompliantContact>(scene.forces);
+    scene.contact->addShapeOnPlane(
+        scene.ball,
+        articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), Vector3d(kEggA, kEggB, kEggC)),
+        Vector3d::Zero(), Vector3d::UnitZ(), laws);
+    run = scene.simulate(eggStart(scene), 1.0);
+  }
+  report(state, run);
+}
+BENCHMARK(BM_EllipsoidOnPlane_Articula)->Unit(benchmark::kMillisecond);
+
+void BM_EllipsoidOnPlane_SimbodyCompliant(benchmark::State& state) {
+  Run run;
+  for (auto _ : state) {
+    Scene scene(kEggMass, eggMoments());
+    SimTK::ContactTrackerSubsystem tracker(scene.system);
+    SimTK::CompliantContactSubsystem compliant(scene.system, tracker);
+    compliant.setTransitionVelocity(kTransition);
+    const SimTK::ContactMaterial material(kSurfaceModulus, kDissipation, kStatic, kDynamic, 0);
+    scene.ball.updBody().addContactSurface(
+        SimTK::Transform(),
+        SimTK::ContactSurface(SimTK::ContactGeometry::Ellipsoid(SimTK::Vec3(kEggA, kEggB, kEggC)), material));
+    scene.matter.updGround().updBody().addContactSurface(
+        SimTK::Transform(SimTK::Rotation(0.5 * SimTK::Pi, SimTK::YAxis), SimTK::Vec3(0)),
+        SimTK::ContactSurface(SimTK::ContactGeometry::HalfSpace(), material));
+    run = scene.simulate(eggStart(scene), 1.0);
+  }
+  report(state, run);
+}
+BENCHMARK(BM_EllipsoidOnPlane_SimbodyCompliant)->Unit(benchmark::kMillisecond);
+
+// The foot scenes as shipped (1 s simulated), at accuracy 10^-range(0); the
+// files go to a scratch folder.
+void footScene(benchmark::State& state, const char* sole) {
+  articula::dynamics::Scene scene =
+      articula::dynamics::readScene(std::filesystem::path(ARTICULA_SCENES_DIR) / (std::string("foot_") + sole + ".json"));
+  scene.accuracy = std::pow(10.0, -static_cast<double>(state.range(0)));
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / (std::string("bench-foot-") + sole);
+  std::filesystem::create_directories(folder);
+  articula::dynamics::SimulationSummary summary;
+  for (auto _ : state) summary = articula::dynamics::simulateScene(scene, folder);
+  state.counters["steps"] = static_cast<double>(summary.steps);
+  state.counters["mean_step_s"] = summary.mean_step;
+  state.counters["min_step_s"] = summary.min_step;
+  state.counters["contact_evaluations"] = static_cast<double>(summary.contact_evaluations);
+  std::filesystem::remove_all(folder);
+}
+void BM_Foot_Surfaces(benchmark::State& state) { footScene(state, "surfaces"); }
+void BM_Foot_Points(benchmark::State& state) { footScene(state, "points"); }
+BENCHMARK(BM_Foot_Surfaces)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Foot_Points)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
