@@ -105,6 +105,8 @@ bad friction 'scene["contacts"][0]["friction"]["transition_speed"] = 0' 'transit
 bad joint-parent 'scene["bodies"].append({"name": "arm", "mass": 1, "inertia": [1, 1, 1], "joint": {"parent": "leg", "point_in_parent": [0, 0, 0], "point_in_child": [0, 0, 0], "axis": [0, 1, 0]}})' 'parent "leg" is not a body listed before this one'
 bad hinged-position 'scene["bodies"].append({"name": "arm", "mass": 1, "inertia": [1, 1, 1], "position": [0, 0, 1], "joint": {"parent": "ball", "point_in_parent": [0, 0, 0], "point_in_child": [0, 0, 0], "axis": [0, 1, 0]}})' '"position" of a hinged body'
 bad joint-axis 'scene["bodies"].append({"name": "arm", "mass": 1, "inertia": [1, 1, 1], "joint": {"parent": "ball", "point_in_parent": [0, 0, 0], "point_in_child": [0, 0, 0], "axis": [0, 0, 0]}})' 'axis: expected a non-zero vector'
+bad tight-cavity 'scene["contacts"][0]["against"]["cavity"]["radii"] = [0.2, 1, 1]' 'holds the sphere'
+bad missing-fits 'scene["contacts"][0]["shape"] = {"model": "sphere", "fits": "no-such-fits.json"}' 'cannot open'
 bad point-in-cavity 'c = scene["contacts"][0]; del c["shape"]; c["point"] = [0, 0, -0.1]' 'a contact point meets a plane only'
 bad nan-position 'scene["bodies"][0]["position"] = [0.9, "x", 1]' 'position: expected three numbers'
 printf '[%.0s' $(seq 1 100000) > "$tmp/deep.json"

@@ -21,6 +21,7 @@
 #include <Simbody.h>
 
 #include "articula/contact/convex_shape.hpp"
+#include "articula/core/error.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
 #include "articula/dynamics/scene.hpp"
 #include "articula/dynamics/simulate.hpp"
@@ -333,6 +334,116 @@ TEST(Dynamics, ABoxOnFourContactPointsRestsAtTheirHertzDepth) {
   const double hertz = std::pow(m * kGravity / (4 * K), 2.0 / 3.0);
   EXPECT_NEAR(depth, hertz, 1e-6 * hertz);
   EXPECT_NEAR(columns.at("box_x_m").back(), 0, 1e-9);  // symmetric: no drift
+}
+
+// An ellipsoidal cavity of equal radii is the spherical one: the closest
+// point's geometry gives the same contact as the closed form, to rounding.
+TEST(Dynamics, AnEllipsoidalCavityOfEqualRadiiIsTheSphericalOne) {
+  const double m = 1.0, r = 0.1, R = 1.0;
+  const auto path = [&](bool ellipsoidal) {
+    BallWorld w(m, 0.4 * m * r * r);
+    CompliantContact contact(w.forces);
+    const ContactLaws laws = hertzLaws(1e7, NormalLaw::HuntCrossley, 0.5, 0.3);
+    if (ellipsoidal)
+      contact.addSphereInEllipsoidalCavity(
+          w.ball, r, articula::contact::makeConvexShape(Vector3d(0, 0, R), Eigen::Matrix3d::Identity(), Vector3d::Constant(R)),
+          laws);
+    else
+      contact.addSphereInCavity(w.ball, r, Vector3d(0, 0, R), R, laws);
+    SimTK::State state = w.start();
+    w.ball.setQToFitTranslation(state, SimTK::Vec3(0.5, 0.2, 0.3));
+    w.ball.setUToFitVelocity(state, SimTK::SpatialVec(SimTK::Vec3(0, 3, 1), SimTK::Vec3(0.5, -1, 0)));
+    Simulation run(w.system, state, 1e-8);
+    std::vector<SimTK::Vec3> out;
+    for (int i = 1; i <= 20; ++i) out.push_back(w.ball.getBodyOriginLocation(run.stepTo(0.05 * i)));
+    return out;
+  };
+  const std::vector<SimTK::Vec3> sphere = path(false), ellipsoid = path(true);
+  for (size_t i = 0; i < sphere.size(); ++i) EXPECT_LT((sphere[i] - ellipsoid[i]).norm(), 1e-7) << i;
+}
+
+// A ball rolling without slip at the bottom of an ellipsoidal bowl (semi-axes
+// A, B, C, the bottom at the end of C) along A: the bottom's radius of
+// curvature in that plane is rho = A^2 / C, and small oscillations have the
+// period 2 pi sqrt(7 (rho - r) / (5 g)).
+TEST(Dynamics, ABallRollingInAnEllipsoidalBowlOscillatesWithItsCurvature) {
+  const double m = 1.0, r = 0.1, A = 1.2, B = 1.0, C = 1.0, K = 1e7;
+  BallWorld w(m, 0.4 * m * r * r);
+  CompliantContact contact(w.forces);
+  ContactLaws laws = hertzLaws(K, NormalLaw::HuntCrossley, 0.1, 0.5);
+  contact.addSphereInEllipsoidalCavity(
+      w.ball, r, articula::contact::makeConvexShape(Vector3d(0, 0, C), Eigen::Matrix3d::Identity(), Vector3d(A, B, C)),
+      laws);
+  SimTK::State state = w.start();
+  // Touching the wall (at the Hertz sag) at x = 0.06 on the bowl's x-z section.
+  const double x = 0.06, z = C - C * std::sqrt(1 - x * x / (A * A));
+  const Vector3d inward = -Vector3d(x / (A * A), 0, (z - C) / (C * C)).normalized();
+  const Vector3d start = Vector3d(x, 0, z) + (r - std::pow(m * kGravity / K, 2.0 / 3.0)) * inward;
+  w.ball.setQToFitTranslation(state, SimTK::Vec3(start.x(), start.y(), start.z()));
+  Simulation run(w.system, state, 1e-8);
+  std::vector<double> crossings;
+  double t_prev = 0, x_prev = start.x();
+  const double dt = 1e-3;
+  for (int i = 1; i <= 5000 && crossings.size() < 3; ++i) {
+    const double xi = w.ball.getBodyOriginLocation(run.stepTo(i * dt))[0];
+    if ((x_prev < 0) != (xi < 0)) crossings.push_back(t_prev + dt * (-x_prev) / (xi - x_prev));
+    t_prev = i * dt;
+    x_prev = xi;
+  }
+  ASSERT_GE(crossings.size(), 3u);
+  const double period = 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  const double rho = A * A / C, rolling = 2 * M_PI * std::sqrt(7.0 * (rho - r) / (5.0 * kGravity));
+  EXPECT_NEAR(period, rolling, 0.005 * rolling) << "the sphere of radius C would give "
+                                                << 2 * M_PI * std::sqrt(7.0 * (C - r) / (5.0 * kGravity)) << " s";
+  EXPECT_THROW(contact.addSphereInEllipsoidalCavity(
+                   w.ball, 0.9, articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), Vector3d(A, B, C)),
+                   laws),
+               articula::InvalidParameter);  // tighter than the ball at the ends of A
+}
+
+// No gravity, no friction: a ball meeting a plane at v0 leaves it at e v0,
+// e the exact restitution of Hunt-Crossley damping (force_laws.hpp).
+TEST(Dynamics, ADroppedBallReboundsWithTheLawsRestitution) {
+  const double v0 = 1.0, c = 0.4;
+  const std::string scene = R"({"gravity": [0, 0, 0], "duration": 0.05, "output_interval": 0.05,
+    "integrator": {"type": "runge-kutta-merson", "accuracy": 1e-11},
+    "bodies": [{"name": "ball", "mass": 0.5, "inertia": [5e-4, 5e-4, 5e-4], "position": [0, 0, 0.0501], "velocity": [0, 0, -1]}],
+    "contacts": [{"body": "ball", "shape": {"model": "sphere", "radii": [0.05, 0.05, 0.05]},
+                  "against": {"plane": {"normal": [0, 0, 1]}},
+                  "normal_law": {"law": "hunt-crossley", "stiffness": 1e7, "dissipation": 0.4}}]})";
+  const auto columns = readColumns(simulateInto(scene, "rebound") / "trajectory.csv");
+  const double e = columns.at("ball_vz_m_s").back() / v0;
+  const double expected = articula::contact::restitutionOfLinearDamping(1.5 * c * v0);
+  EXPECT_LT(expected, 0.9);  // a real loss
+  EXPECT_NEAR(e, expected, 1e-6);
+}
+
+// A contact surface taken from a fits.json (millimetres, as the fit writes
+// them): the fitted sphere of 25 mm, centred on its body, rests on a plane
+// at the Hertz depth of a 0.025 m ball; a model the file lacks is refused.
+TEST(Dynamics, AFittedHeadFromFitsJsonIsAContactSurfaceInMetres) {
+  const std::filesystem::path folder = std::filesystem::path(::testing::TempDir()) / "fitted_head";
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "fits.json") << R"({"models": [{"model": "sphere", "center_mm": [10, 20, 30],
+    "radii_mm": [25, 25, 25], "rotation_deg": [0, 0, 0], "exponents": [2, 2, 2], "cx": [1, 0, 0, 0], "cy": [1, 0, 0, 0]}]})";
+  const double m = 1, K = 1e6, r = 0.025;
+  const auto scene = [&](const std::string& model) {
+    return nlohmann::json::parse(R"({"duration": 2, "output_interval": 0.5,
+      "integrator": {"type": "runge-kutta-merson", "accuracy": 1e-10},
+      "bodies": [{"name": "head", "mass": 1, "inertia": [2.5e-4, 2.5e-4, 2.5e-4], "position": [0, 0, 0.026]}],
+      "contacts": [{"body": "head", "shape": {"model": ")" + model + R"(", "fits": "fits.json", "center": [0, 0, 0]},
+                    "against": {"plane": {"normal": [0, 0, 1]}},
+                    "normal_law": {"law": "hunt-crossley", "stiffness": 1e6, "dissipation": 20}}]})");
+  };
+  const articula::dynamics::Scene read = articula::dynamics::sceneFromJson(scene("sphere"), "scene", folder);
+  ASSERT_EQ(read.contacts.size(), 1u);
+  EXPECT_DOUBLE_EQ(read.contacts[0].shape.radii[0], r);
+  articula::dynamics::simulateScene(read, folder);
+  const auto columns = readColumns(folder / "trajectory.csv");
+  const double depth = r - columns.at("head_z_m").back();
+  const double hertz = std::pow(m * kGravity / K, 2.0 / 3.0);
+  EXPECT_NEAR(depth, hertz, 1e-6 * hertz);
+  EXPECT_THROW(articula::dynamics::sceneFromJson(scene("ellipsoid"), "scene", folder), articula::InputError);
 }
 
 }  // namespace

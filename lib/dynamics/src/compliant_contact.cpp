@@ -7,6 +7,7 @@
 #include "articula/contact/common_normal.hpp"
 #include "articula/contact/plane_contact.hpp"
 #include "articula/core/error.hpp"
+#include "articula/distance/ellipsoid_distance.hpp"
 
 namespace articula::dynamics {
 namespace {
@@ -21,12 +22,12 @@ Eigen::Matrix3d toEigen(const SimTK::Rotation& r) {
   return m;
 }
 
-enum class PairKind { ShapeOnPlane, PointOnPlane, SphereInCavity, ShapePair };
+enum class PairKind { ShapeOnPlane, PointOnPlane, SphereInCavity, SphereInEllipsoid, ShapePair };
 
 struct Pair {
   PairKind kind = PairKind::ShapeOnPlane;
   SimTK::MobilizedBodyIndex body;
-  contact::ConvexShape shape;                  // ShapeOnPlane, ShapePair (A): in the body's frame
+  contact::ConvexShape shape;                  // ShapeOnPlane, ShapePair (A): in the body's frame; SphereInEllipsoid: the cavity, in ground
   double radius = 0, cavity_radius = 0;        // SphereInCavity
   Eigen::Vector3d station = Eigen::Vector3d::Zero();  // PointOnPlane: in the body's frame
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // plane, or cavity centre
@@ -89,6 +90,26 @@ class CompliantContact::Element : public SimTK::Force::Custom::Implementation {
       s.depth = p.normal.dot(p.point - s.point_a);
       s.point_b = s.point_a + s.depth * p.normal;
       s.normal = -p.normal;  // into the plane's solid, as for a shape
+    } else if (p.kind == PairKind::SphereInEllipsoid) {
+      const Eigen::Vector3d center = toEigen(X_GB.p());
+      const Eigen::Vector3d local = p.shape.rotation.transpose() * (center - p.shape.center);
+      Eigen::Vector3d closest;
+      const double signed_distance = distance::ellipsoidClosestPoint(p.shape.radii, local, closest);
+      // Outward of the cavity at its closest point: from the centre to it
+      // inside; at the cavity's own centre along its shortest axis (any
+      // nearest point will do: no contact there unless r >= a_min).
+      Eigen::Vector3d n = closest - local;
+      if (signed_distance > 0) n = -n;
+      if (!(n.norm() > 0)) {
+        Eigen::Index shortest = 0;
+        p.shape.radii.minCoeff(&shortest);
+        n = Eigen::Vector3d::Unit(shortest);
+      }
+      const Eigen::Vector3d u = p.shape.rotation * n.normalized();
+      s.point_a = center + p.radius * u;
+      s.point_b = p.shape.center + p.shape.rotation * closest;
+      s.normal = u;
+      s.depth = p.radius + signed_distance;
     } else {
       const Eigen::Vector3d center = toEigen(X_GB.p());
       Eigen::Vector3d u = center - p.point;
@@ -198,6 +219,24 @@ void CompliantContact::addSphereInCavity(const SimTK::MobilizedBody& body, doubl
   p.radius = radius;
   p.cavity_radius = cavity_radius;
   p.point = cavity_center;
+  p.laws = laws;
+  element_->pairs.push_back(p);
+}
+
+void CompliantContact::addSphereInEllipsoidalCavity(const SimTK::MobilizedBody& body, double radius,
+                                                    const contact::ConvexShape& cavity, const ContactLaws& laws) {
+  laws.normal.validate();
+  laws.friction.validate();
+  if (!cavity.quadric) throw InvalidParameter("cavity exponents", "2, 2, 2 (an ellipsoid)", cavity.exponents.maxCoeff());
+  const double tightest = cavity.radii.minCoeff() * cavity.radii.minCoeff() / cavity.radii.maxCoeff();
+  if (!(radius > 0 && radius <= tightest))
+    throw InvalidParameter("ball radius", "> 0 and at most the cavity's tightest radius of curvature, " +
+                                              std::to_string(tightest), radius);
+  Pair p;
+  p.kind = PairKind::SphereInEllipsoid;
+  p.body = body.getMobilizedBodyIndex();
+  p.radius = radius;
+  p.shape = cavity;
   p.laws = laws;
   element_->pairs.push_back(p);
 }

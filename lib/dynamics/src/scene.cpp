@@ -6,6 +6,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
+#include "articula/fit/fits_json.hpp"
 #include "articula/geometry/pose.hpp"
 
 namespace articula::dynamics {
@@ -151,10 +152,37 @@ ContactLaws readLaws(const json& j, const std::string& where) {
   return laws;
 }
 
-contact::ConvexShape readShape(const json& s, const std::string& sw) {
+/// A fitted head from a fits.json as a contact surface: its model's entry,
+/// millimetres to metres, its pose in the CT's LPS frame (the body's frame)
+/// unless the shape gives `center` or `angles_deg`.
+contact::ConvexShape readFittedShape(const json& s, const std::string& sw, const std::string& model,
+                                     const std::filesystem::path& folder) {
+  std::filesystem::path file = text(s, "fits", sw, std::nullopt);
+  if (file.is_relative()) file = folder / file;
+  const json document = fit::readFitsJson(file, sw + " fits");
+  geometry::ShapeParameters p;
+  bool found = false;
+  for (const geometry::ShapeParameters& q : fit::shapesFromFitsJson(document, file.string()))
+    if (geometry::modelName(q.model) == model) p = q, found = true;
+  if (!found) throw InputError(sw + ": " + file.string() + " has no \"" + excerpt(model) + "\" fit");
+  constexpr double kMetresPerMm = 1e-3;
+  try {
+    contact::ConvexShape shape = contact::shapeFromParameters(p);
+    shape.radii *= kMetresPerMm;
+    shape.center = member(s, "center") ? vector3(s, "center", sw, std::nullopt, 1e3) : Eigen::Vector3d(shape.center * kMetresPerMm);
+    if (member(s, "angles_deg"))
+      shape.rotation = geometry::rotationFromAngles(kDegree * vector3(s, "angles_deg", sw, std::nullopt, 3600));
+    return contact::makeConvexShape(shape.center, shape.rotation, shape.radii, shape.exponents);
+  } catch (const Error& e) {
+    throw InputError(sw + ": " + e.what());
+  }
+}
+
+contact::ConvexShape readShape(const json& s, const std::string& sw, const std::filesystem::path& folder) {
   const std::string model = text(s, "model", sw, std::nullopt);
   if (model != "sphere" && model != "ellipsoid" && model != "superellipsoid")
     refuse(sw, "model", "sphere, ellipsoid or superellipsoid", s.at("model"));
+  if (member(s, "fits")) return readFittedShape(s, sw, model, folder);
   const Eigen::Vector3d radii = vector3(s, "radii", sw, std::nullopt, 1e3);
   const Eigen::Vector3d exponents = vector3(s, "exponents", sw, Eigen::Vector3d::Constant(2.0), 1e3);
   if (model != "superellipsoid" && exponents != Eigen::Vector3d::Constant(2.0))
@@ -170,7 +198,8 @@ contact::ConvexShape readShape(const json& s, const std::string& sw) {
   }
 }
 
-SceneContact readContact(const json& j, const std::string& where, const std::vector<SceneBody>& bodies) {
+SceneContact readContact(const json& j, const std::string& where, const std::vector<SceneBody>& bodies,
+                         const std::filesystem::path& folder) {
   if (!j.is_object()) refuse(where, "contact", "an object", j);
   SceneContact c;
   const std::string body = text(j, "body", where, std::nullopt);
@@ -179,7 +208,7 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   if (member(j, "point") && member(j, "shape")) throw InputError(where + ": either \"shape\" or \"point\", not both");
   c.point_contact = member(j, "point") != nullptr;
   if (c.point_contact) c.station = vector3(j, "point", where, std::nullopt, 1e3);
-  else c.shape = readShape(object(j, "shape", where), where + " shape");
+  else c.shape = readShape(object(j, "shape", where), where + " shape", folder);
   const bool centred_sphere = c.shape.quadric && c.shape.radii.minCoeff() == c.shape.radii.maxCoeff() &&
                               c.shape.center == Eigen::Vector3d::Zero();
   const json& against = object(j, "against", where);
@@ -199,15 +228,32 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
       throw InputError(cw + ": a cavity holds a sphere centred at its body's origin (shape center [0, 0, 0])");
     c.cavity = true;
     c.point = vector3(*cavity, "center", cw, std::nullopt);
-    c.cavity_radius = number(*cavity, "radius", cw, std::nullopt, c.shape.radii[0] * (1 + 1e-9), 1e6,
-                             "a radius larger than the sphere's");
+    if (member(*cavity, "radii")) {
+      // An ellipsoidal cavity: no tighter anywhere than the ball, or it would touch in two places.
+      c.ellipsoidal_cavity = true;
+      const Eigen::Vector3d radii = vector3(*cavity, "radii", cw, std::nullopt, 1e6);
+      const Eigen::Matrix3d rotation =
+          geometry::rotationFromAngles(kDegree * vector3(*cavity, "angles_deg", cw, Eigen::Vector3d::Zero(), 3600));
+      try {
+        c.cavity_shape = contact::makeConvexShape(c.point, rotation, radii);
+      } catch (const Error& e) {
+        throw InputError(cw + ": " + e.what());
+      }
+      const double tightest = radii.minCoeff() * radii.minCoeff() / radii.maxCoeff();
+      if (!(c.shape.radii[0] <= tightest))
+        refuse(cw, "radii", "a cavity whose tightest radius of curvature (a_min^2 / a_max = " + excerpt(std::to_string(tightest)) +
+                                ") holds the sphere", cavity->at("radii"));
+    } else {
+      c.cavity_radius = number(*cavity, "radius", cw, std::nullopt, c.shape.radii[0] * (1 + 1e-9), 1e6,
+                               "a radius larger than the sphere's");
+    }
   } else if (const json* other = member(against, "body")) {
     const std::string ow = where + " against";
     if (!other->is_string()) refuse(ow, "body", "a body's name", *other);
     c.other_body = bodyIndex(other->get<std::string>(), bodies);
     if (c.other_body < 0 || c.other_body == c.body)
       throw InputError(ow + ": body \"" + excerpt(other->get<std::string>()) + "\" is not another of the scene's bodies");
-    c.other_shape = readShape(object(against, "shape", ow), ow + " shape");
+    c.other_shape = readShape(object(against, "shape", ow), ow + " shape", folder);
   } else {
     throw InputError(where + ": against: expected {\"plane\": ...}, {\"cavity\": ...} or {\"body\": ..., \"shape\": ...}, found " +
                      describeJson(against));
@@ -224,7 +270,7 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
 
 }  // namespace
 
-Scene sceneFromJson(const json& document, const std::string& where) {
+Scene sceneFromJson(const json& document, const std::string& where, const std::filesystem::path& folder) {
   if (!document.is_object()) refuse(where, "scene", "a JSON object", document);
   Scene scene;
   scene.source = document;
@@ -258,7 +304,7 @@ Scene sceneFromJson(const json& document, const std::string& where) {
     if (!contacts->is_array() || contacts->size() > 10000)
       refuse(where, "contacts", "an array of up to 10000 contacts", *contacts);
     for (size_t i = 0; i < contacts->size(); ++i)
-      scene.contacts.push_back(readContact((*contacts)[i], where + " contacts[" + std::to_string(i) + "]", scene.bodies));
+      scene.contacts.push_back(readContact((*contacts)[i], where + " contacts[" + std::to_string(i) + "]", scene.bodies, folder));
   }
   return scene;
 }
@@ -272,7 +318,7 @@ Scene readScene(const std::filesystem::path& path) {
   } catch (const json::exception& e) {
     throw InputError(path.string() + ": not a JSON document: " + excerpt(e.what(), 120));
   }
-  return sceneFromJson(document, path.string());
+  return sceneFromJson(document, path.string(), path.parent_path());
 }
 
 }  // namespace articula::dynamics

@@ -82,6 +82,8 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
     const SimTK::MobilizedBody& body = bodies[static_cast<size_t>(c.body)];
     if (c.other_body >= 0)
       contact.addShapePair(body, c.shape, bodies[static_cast<size_t>(c.other_body)], c.other_shape, c.laws);
+    else if (c.cavity && c.ellipsoidal_cavity)
+      contact.addSphereInEllipsoidalCavity(body, c.shape.radii[0], c.cavity_shape, c.laws);
     else if (c.cavity)
       contact.addSphereInCavity(body, c.shape.radii[0], c.point, c.cavity_radius, c.laws);
     else if (c.point_contact)

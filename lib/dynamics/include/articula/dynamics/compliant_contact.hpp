@@ -4,8 +4,8 @@
 // each force evaluation and applies the force laws of contact/force_laws.hpp
 // at the contact points. Pairs: a convex shape (sphere, ellipsoid,
 // superellipsoid) on a body against a plane fixed in ground (the closed form
-// of thesis section 5.3), a sphere inside a spherical cavity fixed in ground
-// (conformal contact, thesis section 5.2.7), two convex shapes on any two
+// of thesis section 5.3), a sphere inside a spherical or ellipsoidal cavity
+// fixed in ground (conformal contact, thesis section 5.2.7), two convex shapes on any two
 // bodies (the common-normal / dual solver, warm-started per pair), and a
 // point on a body against a plane (the point elements of foot-ground
 // models, thesis ch. 6). SI units.
@@ -54,6 +54,15 @@ class CompliantContact {
   /// cavity of `cavity_radius` centred at `cavity_center` (ground).
   void addSphereInCavity(const SimTK::MobilizedBody& body, double radius, const Eigen::Vector3d& cavity_center,
                          double cavity_radius, const ContactLaws& laws);
+
+  /// A ball of `radius` centred at the body's origin inside the ellipsoid
+  /// `cavity` (ground frame; exponents 2): the exact closest point of the
+  /// cavity's surface to the ball's centre (distance/ellipsoid_distance.hpp)
+  /// gives the depth and the normal. The ball must be no larger than the
+  /// cavity's tightest curvature (radius a_min^2 / a_max), or it could
+  /// touch at two places; InvalidParameter otherwise.
+  void addSphereInEllipsoidalCavity(const SimTK::MobilizedBody& body, double radius,
+                                    const contact::ConvexShape& cavity, const ContactLaws& laws);
 
   /// Two convex shapes, each given in its body's frame (either body may be
   /// Ground): the minimum signed distance of contact/common_normal.hpp,

@@ -3,7 +3,8 @@
 // bodies under gravity, free or hinged to a parent body by a revolute joint
 // with passive stiffness and damping, each with contact surfaces (sphere,
 // ellipsoid, superellipsoid in the thesis form) against a plane or inside a
-// spherical cavity fixed in ground, or against another body's surface, or
+// spherical or ellipsoidal cavity fixed in ground, or against another body's surface (each
+// given by its parameters, or as fitted: a model of a fits.json), or
 // contact points against a plane (the point elements surfaces are compared
 // with); the contact laws, the integrator and the output.
 // SI units; angles in degrees in the file.
@@ -53,7 +54,9 @@ struct SceneContact {
   int other_body = -1;                  // against another body's shape (>= 0), else a plane or a cavity
   contact::ConvexShape other_shape;     // in that body's frame
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // plane, or cavity centre
-  double cavity_radius = 0;
+  double cavity_radius = 0;             // a spherical cavity
+  bool ellipsoidal_cavity = false;      // else the cavity is this ellipsoid (ground frame)
+  contact::ConvexShape cavity_shape;
   ContactLaws laws;
 };
 
@@ -74,7 +77,9 @@ struct Scene {
 /// first field that is missing, of the wrong type or out of its range.
 Scene readScene(const std::filesystem::path& path);
 
-/// The same from a parsed document; `where` names it in messages.
-Scene sceneFromJson(const nlohmann::json& document, const std::string& where);
+/// The same from a parsed document; `where` names it in messages, and
+/// relative paths in it (a shape's "fits") are taken from `folder`.
+Scene sceneFromJson(const nlohmann::json& document, const std::string& where,
+                    const std::filesystem::path& folder = {});
 
 }  // namespace articula::dynamics
