@@ -4,7 +4,8 @@
 // command itself, run with the arguments its executable would get, so OUTDIR
 // holds exactly the files the stage apps write. A stage
 // whose outputs exist and whose inputs (SHA-256) and arguments are unchanged
-// is skipped (stamps in OUTDIR/.articula/).
+// is skipped (stamps in OUTDIR/.articula/). The CT is read once: the stages
+// that take it get it from memory (imaging::VolumeMemory).
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include "articula/core/number_text.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
+#include "articula/imaging/io.hpp"
 #include "articula/pipeline/stages.hpp"
 
 namespace articula::apps {
@@ -91,6 +93,7 @@ class RunCommand : public cli::Command {
     if (const std::string problem = argumentsProblem(common); !problem.empty()) throw UsageError(problem);
     if (!fs::exists(input_)) throw InputError("input '" + input_.string() + "' does not exist: expected a DICOM folder or a CT image file");
     fs::create_directories(output_ / ".articula");
+    const imaging::VolumeMemory read_once;
     if (const int stale = removeStaleTemporaries(output_))
       log::info("removed " + std::to_string(stale) + " unfinished file(s) of an interrupted earlier run");
     for (int i = first; i <= last; ++i) {

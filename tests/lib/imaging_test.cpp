@@ -2,6 +2,7 @@
 // bad-input checks refuse with exit code 3, and the head segmentation of the
 // phantom matches its truth; the real CTs give one plausible head.
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -52,6 +53,39 @@ TEST(ImagingIo, NiftiRoundTripKeepsLpsGeometryEvenWhenStoredRas) {
     EXPECT_LE(worst, 0.5 + 1e-6);  // stored as int16
     std::filesystem::remove_all(dir);
   }
+}
+
+// A volume read again while a VolumeMemory is alive comes from memory, the
+// same voxels; a file changed since (size or time) is read anew; without a
+// memory every read goes to the file.
+TEST(ImagingIo, VolumeMemoryAnswersARepeatedReadUntilTheFileChanges) {
+  const phantom::Phantom p = smallPhantom(5);
+  const auto dir = testing::scratch("memory");
+  imaging::writeVolume(dir / "ct.nii.gz", p.ct);
+  {
+    const imaging::VolumeMemory memory;
+    const imaging::Volume first = imaging::readVolume(dir / "ct.nii.gz", {});
+    const imaging::Volume again = imaging::readVolume(dir / "ct.nii.gz", {});
+    EXPECT_EQ(memory.hits(), 1);
+    EXPECT_EQ(first.voxels, again.voxels);
+    imaging::ReadOptions other;
+    other.spacing_tolerance = 0.02;
+    imaging::readVolume(dir / "ct.nii.gz", other);  // other options: another read
+    EXPECT_EQ(memory.hits(), 1);
+    imaging::Volume changed = p.ct;
+    for (float& v : changed.voxels) v += 100;
+    imaging::writeVolume(dir / "ct.nii.gz", changed);
+    std::filesystem::last_write_time(dir / "ct.nii.gz", std::filesystem::last_write_time(dir / "ct.nii.gz") +
+                                                            std::chrono::seconds(2));
+    const imaging::Volume reread = imaging::readVolume(dir / "ct.nii.gz", other);
+    EXPECT_EQ(memory.hits(), 1);
+    EXPECT_NEAR(reread.voxels[0], first.voxels[0] + 100, 0.5);
+    EXPECT_THROW(imaging::VolumeMemory second, ProcessingError);  // one at a time
+  }
+  const imaging::VolumeMemory fresh;
+  imaging::readVolume(dir / "ct.nii.gz", {});
+  EXPECT_EQ(fresh.hits(), 0);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ImagingIo, DicomSeriesRoundTripAndChecks) {

@@ -426,8 +426,83 @@ std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
   return out;
 }
 
-Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport* report_out) {
+struct VolumeMemory::Kept {
+  std::string key;  // the input, its options and its files' fingerprint
+  Volume volume;
   ReadReport report;
+  long long hits = 0;
+};
+
+namespace {
+
+VolumeMemory::Kept* g_volume_memory = nullptr;
+
+/// What identifies a read: the input's path and options, and every file's
+/// name, size and modification time (a folder's recursively, in name order).
+std::string readKey(const fs::path& input, const ReadOptions& options) {
+  std::ostringstream key;
+  key << fs::absolute(input).string() << '\n' << options.series_uid << '\n' << options.spacing_tolerance << '\n'
+      << options.tilt_tolerance_deg << '\n';
+  std::error_code ec;
+  const auto stamp = [&](const fs::path& file) {
+    key << file.string() << ' ' << fs::file_size(file, ec) << ' '
+        << fs::last_write_time(file, ec).time_since_epoch().count() << '\n';
+  };
+  if (fs::is_directory(input, ec)) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::recursive_directory_iterator(input, ec))
+      if (e.is_regular_file(ec)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& f : files) stamp(f);
+  } else {
+    stamp(input);
+  }
+  return key.str();
+}
+
+Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, ReadReport& report);
+
+}  // namespace
+
+VolumeMemory::VolumeMemory() : kept_(new Kept) {
+  if (g_volume_memory) {
+    delete kept_;
+    throw ProcessingError("one volume memory at a time");
+  }
+  g_volume_memory = kept_;
+}
+
+VolumeMemory::~VolumeMemory() {
+  g_volume_memory = nullptr;
+  delete kept_;
+}
+
+long long VolumeMemory::hits() const { return kept_->hits; }
+
+Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport* report_out) {
+  if (!g_volume_memory) {
+    ReadReport report;
+    Volume volume = readVolumeFromFiles(input, options, report);
+    if (report_out) *report_out = report;
+    return volume;
+  }
+  VolumeMemory::Kept& kept = *g_volume_memory;
+  const std::string key = readKey(input, options);
+  if (key == kept.key) {
+    ++kept.hits;
+  } else {
+    kept.key.clear();  // a failed read keeps nothing
+    kept.volume = readVolumeFromFiles(input, options, kept.report);
+    kept.key = key;
+  }
+  if (report_out) *report_out = kept.report;
+  return kept.volume;
+}
+
+namespace {
+
+Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, ReadReport& report) {
+  report = ReadReport{};
   Volume volume;
   if (fs::is_directory(input)) {
     volume = readDicom(input, options, report);
@@ -443,9 +518,10 @@ Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport*
     throw InputError("expected a 3-D volume in " + input.string() + ", found size " +
                      std::to_string(volume.geometry.size[0]) + "x" + std::to_string(volume.geometry.size[1]) + "x" +
                      std::to_string(volume.geometry.size[2]));
-  if (report_out) *report_out = report;
   return volume;
 }
+
+}  // namespace
 
 Label readLabel(const fs::path& input) {
   if (!fs::is_regular_file(input)) throw InputError("label image not found: " + input.string());

@@ -50,6 +50,25 @@ std::vector<SeriesInfo> listDicomSeries(const std::filesystem::path& folder);
 /// non-orthonormal direction matrix.
 Volume readVolume(const std::filesystem::path& input, const ReadOptions& options, ReadReport* report = nullptr);
 
+/// While one is alive, readVolume keeps the last volume it read and answers
+/// the same input read again with the same options from memory, provided its
+/// files are unchanged (names, sizes and modification times): `articula run`
+/// reads the CT once for all its stages instead of once per stage. One at a
+/// time per process; the stages of a run follow one another, so no locking.
+class VolumeMemory {
+ public:
+  VolumeMemory();
+  ~VolumeMemory();
+  VolumeMemory(const VolumeMemory&) = delete;
+  VolumeMemory& operator=(const VolumeMemory&) = delete;
+  long long hits() const;  // reads answered from memory
+
+  struct Kept;  // the kept volume (io.cpp)
+
+ private:
+  Kept* kept_;
+};
+
 /// Reads a label image (any integer type, non-zero = 1).
 Label readLabel(const std::filesystem::path& input);
 
