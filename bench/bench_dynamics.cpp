@@ -43,6 +43,13 @@ struct Scene : BallWorld {
   using BallWorld::BallWorld;
   std::unique_ptr<CompliantContact> contact;
 
+  // articula's element: an axis-aligned ellipsoid of `radii` at the body's origin on the plane z = 0.
+  void addOnGround(const Vector3d& radii, const ContactLaws& laws) {
+    contact = std::make_unique<CompliantContact>(forces);
+    contact->addShapeOnPlane(ball, articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), radii),
+                             Vector3d::Zero(), Vector3d::UnitZ(), laws);
+  }
+
   Run simulate(const SimTK::State& state, double duration) {
     Simulation run(system, state, 1e-6);
     run.stepTo(duration);
@@ -61,6 +68,18 @@ SimTK::State sphereOnPlaneStart(Scene& scene) {
   return state;
 }
 
+// The material of the plane scenes with a Hertz stiffness K (Simbody's peers take the modulus).
+ContactLaws planeLaws(double stiffness) {
+  ContactLaws laws;
+  laws.normal.law = articula::contact::NormalLaw::HuntCrossley;
+  laws.normal.stiffness = stiffness;
+  laws.normal.dissipation = kDissipation;
+  laws.friction.dynamic = kDynamic;
+  laws.friction.static_peak = kStatic;
+  laws.friction.transition_speed = kTransition;
+  return laws;
+}
+
 void report(benchmark::State& state, const Run& run) {
   state.counters["steps"] = run.steps;
   state.counters["mean_step_s"] = run.simulated / run.steps;
@@ -71,18 +90,8 @@ void BM_SphereOnPlane_Articula(benchmark::State& state) {
   Run run;
   for (auto _ : state) {
     Scene scene(kMass, 0.4 * kMass * kRadius * kRadius);
-    ContactLaws laws;
-    laws.normal.law = articula::contact::NormalLaw::HuntCrossley;
-    laws.normal.stiffness = 4.0 / 3.0 * std::sqrt(kRadius) * kSurfaceModulus / std::pow(2.0, 1.5);
-    laws.normal.dissipation = kDissipation;
-    laws.friction.dynamic = kDynamic;
-    laws.friction.static_peak = kStatic;
-    laws.friction.transition_speed = kTransition;
-    scene.contact = std::make_unique<CompliantContact>(scene.forces);
-    scene.contact->addShapeOnPlane(
-        scene.ball,
-        articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), Vector3d::Constant(kRadius)),
-        Vector3d::Zero(), Vector3d::UnitZ(), laws);
+    scene.addOnGround(Vector3d::Constant(kRadius),
+                      planeLaws(4.0 / 3.0 * std::sqrt(kRadius) * kSurfaceModulus / std::pow(2.0, 1.5)));
     run = scene.simulate(sphereOnPlaneStart(scene), 1.0);
   }
   report(state, run);
@@ -155,19 +164,9 @@ void BM_EllipsoidOnPlane_Articula(benchmark::State& state) {
   Run run;
   for (auto _ : state) {
     Scene scene(kEggMass, eggMoments());
-    ContactLaws laws;
-    laws.normal.law = articula::contact::NormalLaw::HuntCrossley;
-    laws.normal.stiffness = articula::contact::hertzStiffness(kEggC / (kEggA * kEggA), kEggC / (kEggB * kEggB),
-                                                              kSurfaceModulus / std::pow(2.0, 1.5));
-    laws.normal.dissipation = kDissipation;
-    laws.friction.dynamic = kDynamic;
-    laws.friction.static_peak = kStatic;
-    laws.friction.transition_speed = kTransition;
-    scene.contact = std::make_unique<CompliantContact>(scene.forces);
-    scene.contact->addShapeOnPlane(
-        scene.ball,
-        articula::contact::makeConvexShape(Vector3d::Zero(), Eigen::Matrix3d::Identity(), Vector3d(kEggA, kEggB, kEggC)),
-        Vector3d::Zero(), Vector3d::UnitZ(), laws);
+    scene.addOnGround(Vector3d(kEggA, kEggB, kEggC),
+                      planeLaws(articula::contact::hertzStiffness(kEggC / (kEggA * kEggA), kEggC / (kEggB * kEggB),
+                                                                  kSurfaceModulus / std::pow(2.0, 1.5))));
     run = scene.simulate(eggStart(scene), 1.0);
   }
   report(state, run);

@@ -52,6 +52,28 @@ ContactLaws hertzLaws(double stiffness, NormalLaw law, double dissipation, doubl
   return laws;
 }
 
+/// The period of an oscillation sampled as x(t): twice the mean time between
+/// its first `crossings` zero crossings (linear interpolation between
+/// samples); NaN when it crosses fewer times.
+double periodFromZeroCrossings(const std::vector<double>& t, const std::vector<double>& x, size_t crossings) {
+  std::vector<double> at;
+  for (size_t i = 1; i < t.size() && at.size() < crossings; ++i)
+    if ((x[i - 1] < 0) != (x[i] < 0)) at.push_back(t[i - 1] + (t[i] - t[i - 1]) * x[i - 1] / (x[i - 1] - x[i]));
+  if (at.size() < crossings || crossings < 2) return std::nan("");
+  return 2 * (at.back() - at.front()) / static_cast<double>(at.size() - 1);
+}
+
+/// The ball's x every millisecond for `seconds` of a run.
+void sampleX(const BallWorld& w, Simulation& run, double seconds, std::vector<double>& t, std::vector<double>& x) {
+  const double dt = 1e-3;
+  t.push_back(0);
+  x.push_back(w.ball.getBodyOriginLocation(run.integrator.getState())[0]);
+  for (int i = 1; i * dt <= seconds; ++i) {
+    t.push_back(i * dt);
+    x.push_back(w.ball.getBodyOriginLocation(run.stepTo(i * dt))[0]);
+  }
+}
+
 TEST(Dynamics, ABallSettlesOnAPlaneAtTheHertzDepth) {
   const double m = 1.0, r = 0.1, K = 1e7;
   BallWorld w(m, 0.4 * m * r * r);
@@ -152,18 +174,9 @@ TEST(Dynamics, ABallRollingInABowlOscillatesWithTheRollingPeriod) {
   const double arm = R - r + sag;
   w.ball.setQToFitTranslation(state, SimTK::Vec3(arm * std::sin(angle), 0, R - arm * std::cos(angle)));
   Simulation run(w.system, state, 1e-8);
-  // Crossings of x = 0 (linear interpolation between samples), half a period apart.
-  std::vector<double> crossings;
-  double t_prev = 0, x_prev = w.ball.getBodyOriginLocation(run.integrator.getState())[0];
-  const double dt = 1e-3;
-  for (int i = 1; i <= 4000 && crossings.size() < 3; ++i) {
-    const double x = w.ball.getBodyOriginLocation(run.stepTo(i * dt))[0];
-    if ((x_prev < 0) != (x < 0)) crossings.push_back(t_prev + dt * (-x_prev) / (x - x_prev));
-    t_prev = i * dt;
-    x_prev = x;
-  }
-  ASSERT_GE(crossings.size(), 3u);
-  const double period = 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  std::vector<double> t, x;
+  sampleX(w, run, 3.0, t, x);
+  const double period = periodFromZeroCrossings(t, x, 3);
   const double rolling = 2 * M_PI * std::sqrt(7.0 * (R - r) / (5.0 * kGravity));
   EXPECT_NEAR(period, rolling, 0.005 * rolling) << "sliding: " << 2 * M_PI * std::sqrt((R - r) / kGravity) << " s";
 }
@@ -299,15 +312,10 @@ TEST(Dynamics, AHingedArmSwingsWithTheTorsionPendulumsPeriod) {
   // The arm's centre along the swing's tangent at rest, (axis x x) / |...|: proportional to sin(theta).
   const Vector3d tangent = Vector3d(0, 1, 1).normalized().cross(Vector3d::UnitX());
   const auto& t = columns.at("time_s");
-  std::vector<double> crossings;
-  double previous = 0;
-  for (size_t i = 0; i < t.size(); ++i) {
-    const double s = tangent.dot(Vector3d(columns.at("arm_x_m")[i], columns.at("arm_y_m")[i], columns.at("arm_z_m")[i]));
-    if (i > 0 && (previous < 0) != (s < 0)) crossings.push_back(t[i - 1] + (t[i] - t[i - 1]) * previous / (previous - s));
-    previous = s;
-  }
-  ASSERT_GE(crossings.size(), 5u);
-  const double period = 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  std::vector<double> along(t.size());
+  for (size_t i = 0; i < t.size(); ++i)
+    along[i] = tangent.dot(Vector3d(columns.at("arm_x_m")[i], columns.at("arm_y_m")[i], columns.at("arm_z_m")[i]));
+  const double period = periodFromZeroCrossings(t, along, 6);
   const double expected = 2 * M_PI * std::sqrt((inertia + m * arm * arm) / k);
   EXPECT_NEAR(period, expected, 1e-4 * expected);
   const auto& energy = columns.at("total_j");
@@ -376,22 +384,14 @@ TEST(Dynamics, ABallRollingInAnEllipsoidalBowlOscillatesWithItsCurvature) {
       laws);
   SimTK::State state = w.start();
   // Touching the wall (at the Hertz sag) at x = 0.06 on the bowl's x-z section.
-  const double x = 0.06, z = C - C * std::sqrt(1 - x * x / (A * A));
-  const Vector3d inward = -Vector3d(x / (A * A), 0, (z - C) / (C * C)).normalized();
-  const Vector3d start = Vector3d(x, 0, z) + (r - std::pow(m * kGravity / K, 2.0 / 3.0)) * inward;
+  const double x0 = 0.06, z0 = C - C * std::sqrt(1 - x0 * x0 / (A * A));
+  const Vector3d inward = -Vector3d(x0 / (A * A), 0, (z0 - C) / (C * C)).normalized();
+  const Vector3d start = Vector3d(x0, 0, z0) + (r - std::pow(m * kGravity / K, 2.0 / 3.0)) * inward;
   w.ball.setQToFitTranslation(state, SimTK::Vec3(start.x(), start.y(), start.z()));
   Simulation run(w.system, state, 1e-8);
-  std::vector<double> crossings;
-  double t_prev = 0, x_prev = start.x();
-  const double dt = 1e-3;
-  for (int i = 1; i <= 5000 && crossings.size() < 3; ++i) {
-    const double xi = w.ball.getBodyOriginLocation(run.stepTo(i * dt))[0];
-    if ((x_prev < 0) != (xi < 0)) crossings.push_back(t_prev + dt * (-x_prev) / (xi - x_prev));
-    t_prev = i * dt;
-    x_prev = xi;
-  }
-  ASSERT_GE(crossings.size(), 3u);
-  const double period = 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  std::vector<double> t, x;
+  sampleX(w, run, 3.6, t, x);
+  const double period = periodFromZeroCrossings(t, x, 3);
   const double rho = A * A / C, rolling = 2 * M_PI * std::sqrt(7.0 * (rho - r) / (5.0 * kGravity));
   EXPECT_NEAR(period, rolling, 0.005 * rolling) << "the sphere of radius C would give "
                                                 << 2 * M_PI * std::sqrt(7.0 * (C - r) / (5.0 * kGravity)) << " s";

@@ -170,91 +170,84 @@ CompliantContact::CompliantContact(SimTK::GeneralForceSubsystem& forces) {
 
 CompliantContact::~CompliantContact() = default;
 
+namespace {
+
+// A pair of `kind` on `body` with checked laws; the caller fills in its geometry.
+Pair newPair(PairKind kind, const SimTK::MobilizedBody& body, const ContactLaws& laws) {
+  laws.normal.validate();
+  laws.friction.validate();
+  Pair p;
+  p.kind = kind;
+  p.body = body.getMobilizedBodyIndex();
+  p.laws = laws;
+  return p;
+}
+
+// A pair against the plane through `point` with outward `normal` (ground).
+Pair newPlanePair(PairKind kind, const SimTK::MobilizedBody& body, const Eigen::Vector3d& point,
+                  const Eigen::Vector3d& normal, const ContactLaws& laws) {
+  if (!(normal.allFinite() && normal.norm() > 0 && point.allFinite()))
+    throw InvalidParameter("contact plane normal", "a finite non-zero vector", normal.norm());
+  Pair p = newPair(kind, body, laws);
+  p.point = point;
+  p.normal = normal.normalized();
+  return p;
+}
+
+}  // namespace
+
 void CompliantContact::addShapeOnPlane(const SimTK::MobilizedBody& body, const contact::ConvexShape& shape,
                                        const Eigen::Vector3d& plane_point, const Eigen::Vector3d& plane_normal,
                                        const ContactLaws& laws) {
-  laws.normal.validate();
-  laws.friction.validate();
-  if (!(plane_normal.allFinite() && plane_normal.norm() > 0 && plane_point.allFinite()))
-    throw InvalidParameter("contact plane normal", "a finite non-zero vector", plane_normal.norm());
-  Pair p;
-  p.kind = PairKind::ShapeOnPlane;
-  p.body = body.getMobilizedBodyIndex();
+  Pair p = newPlanePair(PairKind::ShapeOnPlane, body, plane_point, plane_normal, laws);
   p.shape = shape;
-  p.point = plane_point;
-  p.normal = plane_normal.normalized();
-  p.laws = laws;
   element_->pairs.push_back(p);
 }
 
 void CompliantContact::addPointOnPlane(const SimTK::MobilizedBody& body, const Eigen::Vector3d& station,
                                        const Eigen::Vector3d& plane_point, const Eigen::Vector3d& plane_normal,
                                        const ContactLaws& laws) {
-  laws.normal.validate();
-  laws.friction.validate();
-  if (!(plane_normal.allFinite() && plane_normal.norm() > 0 && plane_point.allFinite()))
-    throw InvalidParameter("contact plane normal", "a finite non-zero vector", plane_normal.norm());
   if (!station.allFinite()) throw InvalidParameter("contact point", "finite coordinates", station.norm());
-  Pair p;
-  p.kind = PairKind::PointOnPlane;
-  p.body = body.getMobilizedBodyIndex();
+  Pair p = newPlanePair(PairKind::PointOnPlane, body, plane_point, plane_normal, laws);
   p.station = station;
-  p.point = plane_point;
-  p.normal = plane_normal.normalized();
-  p.laws = laws;
   element_->pairs.push_back(p);
 }
 
 void CompliantContact::addSphereInCavity(const SimTK::MobilizedBody& body, double radius,
                                          const Eigen::Vector3d& cavity_center, double cavity_radius,
                                          const ContactLaws& laws) {
-  laws.normal.validate();
-  laws.friction.validate();
   if (!(radius > 0 && std::isfinite(radius))) throw InvalidParameter("ball radius", "> 0", radius);
   if (!(cavity_radius > radius && std::isfinite(cavity_radius)))
     throw InvalidParameter("cavity radius", "larger than the ball's", cavity_radius);
-  Pair p;
-  p.kind = PairKind::SphereInCavity;
-  p.body = body.getMobilizedBodyIndex();
+  Pair p = newPair(PairKind::SphereInCavity, body, laws);
   p.radius = radius;
   p.cavity_radius = cavity_radius;
   p.point = cavity_center;
-  p.laws = laws;
   element_->pairs.push_back(p);
 }
 
 void CompliantContact::addSphereInEllipsoidalCavity(const SimTK::MobilizedBody& body, double radius,
                                                     const contact::ConvexShape& cavity, const ContactLaws& laws) {
-  laws.normal.validate();
-  laws.friction.validate();
   if (!cavity.quadric) throw InvalidParameter("cavity exponents", "2, 2, 2 (an ellipsoid)", cavity.exponents.maxCoeff());
   const double tightest = cavity.radii.minCoeff() * cavity.radii.minCoeff() / cavity.radii.maxCoeff();
   if (!(radius > 0 && radius <= tightest))
     throw InvalidParameter("ball radius", "> 0 and at most the cavity's tightest radius of curvature, " +
                                               std::to_string(tightest), radius);
-  Pair p;
-  p.kind = PairKind::SphereInEllipsoid;
-  p.body = body.getMobilizedBodyIndex();
+  Pair p = newPair(PairKind::SphereInEllipsoid, body, laws);
   p.radius = radius;
   p.shape = cavity;
-  p.laws = laws;
   element_->pairs.push_back(p);
 }
 
 void CompliantContact::addShapePair(const SimTK::MobilizedBody& body_a, const contact::ConvexShape& shape_a,
                                     const SimTK::MobilizedBody& body_b, const contact::ConvexShape& shape_b,
                                     const ContactLaws& laws) {
-  laws.normal.validate();
-  laws.friction.validate();
   if (body_a.getMobilizedBodyIndex() == body_b.getMobilizedBodyIndex())
     throw InvalidParameter("contact pair", "two different bodies", static_cast<double>(body_a.getMobilizedBodyIndex()));
-  Pair p;
-  p.kind = PairKind::ShapePair;
-  p.body = body_a.getMobilizedBodyIndex();
+  Pair p = newPair(PairKind::ShapePair, body_a, laws);
   p.shape = shape_a;
   p.body_b = body_b.getMobilizedBodyIndex();
   p.shape_b = shape_b;
-  p.laws = laws;
   element_->pairs.push_back(p);
 }
 
