@@ -19,6 +19,7 @@
 #include "articula/contact/pairs_csv.hpp"
 #include "articula/contact/plane_contact.hpp"
 #include "articula/contact/scenario.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
@@ -65,14 +66,7 @@ double timeNs(F&& f, int repeats = 5) {
 // extra rigid pose x' = R_pose x + t_pose applied on top of the fit.
 ConvexShape shapeFromFits(const std::filesystem::path& path, const std::string& model_name,
                           const Eigen::Matrix3d& R_pose, const Vector3d& t_pose) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read fits file '" + path.string() + "'");
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const std::exception& e) {
-    throw InputError(path.string() + ": not valid JSON (" + e.what() + ")");
-  }
+  const nlohmann::json j = readJsonFile(path, "fits");
   try {
     const std::string wanted = model_name.empty() ? j.at("best_model").get<std::string>() : model_name;
     for (const auto& m : j.at("models")) {

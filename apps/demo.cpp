@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "articula/cli/command.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
@@ -22,9 +23,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 json readJson(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw ProcessingError("expected '" + path.string() + "' to exist after the previous step");
-  return json::parse(in);
+  if (!fs::exists(path)) throw ProcessingError("expected '" + path.string() + "' to exist after the previous step");
+  return readJsonFile(path, "demo");
 }
 
 Eigen::Vector3d vec(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()}; }

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "articula/cli/command.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/output_paths.hpp"
@@ -93,7 +94,7 @@ class ErrorsCommand : public cli::Command {
   int run(const cli::CommonOptions& common) override {
     const points::PointCloud cloud = points::readPoints(input_);
     points::checkFittable(cloud, 1, input_.string());
-    const nlohmann::json doc = fit::readFitsJson(fits_, "--fits");
+    const nlohmann::json doc = readJsonFile(fits_, "--fits");
     const std::vector<geometry::ShapeParameters> shapes = fit::shapesFromFitsJson(doc, fits_.string());
     if (std::filesystem::exists(output_) && !std::filesystem::is_directory(output_))
       throw UsageError("--output: expected a folder, found the file '" + output_.string() + "'");

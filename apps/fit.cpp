@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "articula/cli/command.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
@@ -25,14 +26,7 @@ using geometry::ShapeModel;
 
 // --bounds FILE: {"a": [lo, hi], "gamma1": [2, 3], ...} (names of thesis table 3.2).
 std::map<std::string, std::pair<double, double>> readBounds(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("--bounds: cannot open '" + path.string() + "'");
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const std::exception& e) {
-    throw InputError("--bounds: '" + path.string() + "' is not valid JSON: " + e.what());
-  }
+  const nlohmann::json j = readJsonFile(path, "--bounds");
   if (!j.is_object()) throw InputError("--bounds: '" + path.string() + "': expected an object of name: [lower, upper]");
   std::map<std::string, std::pair<double, double>> bounds;
   for (const auto& [name, v] : j.items()) {

@@ -11,10 +11,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "articula/cli/command.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/number_text.hpp"
@@ -122,10 +124,7 @@ class RunCommand : public cli::Command {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     log::info("run: done in " + number(seconds) + " s: " + (output_ / "results.json").string());
-    if (common.json && fs::exists(output_ / "results.json")) {
-      std::ifstream in(output_ / "results.json");
-      cli::printJson(json::parse(in));
-    }
+    if (common.json && fs::exists(output_ / "results.json")) cli::printJson(readJsonFile(output_ / "results.json", "run"));
     return 0;
   }
 
@@ -188,13 +187,12 @@ class RunCommand : public cli::Command {
   static bool upToDate(const Plan& plan, const json& stamp, const fs::path& stamp_path) {
     for (const auto& out : plan.outputs)
       if (!fs::exists(out)) return false;
-    std::ifstream in(stamp_path);
-    if (!in) return false;
+    const std::optional<json> old = readJsonFileIfValid(stamp_path);
+    if (!old) return false;
     try {
-      const json old = json::parse(in);
-      if (!(old.at("args") == stamp.at("args") && old.at("inputs") == stamp.at("inputs"))) return false;
+      if (!(old->at("args") == stamp.at("args") && old->at("inputs") == stamp.at("inputs"))) return false;
       for (const auto& out : plan.outputs)
-        if (old.at("outputs").value(out.string(), "") != hashInput(out)) return false;
+        if (old->at("outputs").value(out.string(), "") != hashInput(out)) return false;
       return true;
     } catch (const json::exception&) {
       return false;

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <optional>
 
+#include "articula/core/json_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
 #include "articula/fit/fits_json.hpp"
@@ -159,7 +160,7 @@ contact::ConvexShape readFittedShape(const json& s, const std::string& sw, const
                                      const std::filesystem::path& folder) {
   std::filesystem::path file = text(s, "fits", sw, std::nullopt);
   if (file.is_relative()) file = folder / file;
-  const json document = fit::readFitsJson(file, sw + " fits");
+  const json document = readJsonFile(file, sw + " fits");
   geometry::ShapeParameters p;
   bool found = false;
   for (const geometry::ShapeParameters& q : fit::shapesFromFitsJson(document, file.string()))
@@ -310,15 +311,7 @@ Scene sceneFromJson(const json& document, const std::string& where, const std::f
 }
 
 Scene readScene(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open the scene '" + path.string() + "'");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(path.string() + ": not a JSON document: " + excerpt(e.what(), 120));
-  }
-  return sceneFromJson(document, path.string(), path.parent_path());
+  return sceneFromJson(readJsonFile(path, "scene"), path.string(), path.parent_path());
 }
 
 }  // namespace articula::dynamics

@@ -121,18 +121,6 @@ geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::
   return p;
 }
 
-nlohmann::json readFitsJson(const std::filesystem::path& path, const std::string& what) {
-  std::ifstream in(path);
-  if (!in) throw InputError(what + ": cannot open '" + path.string() + "'");
-  nlohmann::json doc;
-  try {
-    in >> doc;
-  } catch (const std::exception& e) {
-    throw InputError(what + ": '" + path.string() + "' is not valid JSON: " + e.what());
-  }
-  return doc;
-}
-
 std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where) {
   if (!document.is_object() || !document.contains("models") || !document.at("models").is_array() ||
       document.at("models").empty())

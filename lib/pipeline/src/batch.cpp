@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
@@ -63,14 +64,9 @@ std::string errorMessage(const fs::path& log, int exit_code) {
 }
 
 bool finishedEarlier(const fs::path& dir) {
-  std::ifstream in(dir / "status.json");
-  if (!in || !fs::exists(dir / "results.json")) return false;
-  try {
-    const auto status = nlohmann::json::parse(in);
-    return status.value("status", "") == "ok";
-  } catch (const nlohmann::json::exception&) {
-    return false;
-  }
+  if (!fs::exists(dir / "results.json")) return false;
+  const auto status = readJsonFileIfValid(dir / "status.json");
+  return status && status->is_object() && status->value("status", "") == "ok";
 }
 
 }  // namespace
@@ -151,14 +147,7 @@ BatchSummary gatherOutcomes(const std::vector<Subject>& subjects, const fs::path
     out.id = s.id;
     out.resumed = true;
     const fs::path dir = subjectDir(study_dir, s.id);
-    std::ifstream in(dir / "status.json");
-    nlohmann::json status;
-    if (in) {
-      try {
-        status = nlohmann::json::parse(in);
-      } catch (const nlohmann::json::exception&) {
-      }
-    }
+    const nlohmann::json status = readJsonFileIfValid(dir / "status.json").value_or(nullptr);
     if (status.is_object()) {
       out.status = status.value("status", "failed");
       out.exit_code = status.value("exit_code", 1);

@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
@@ -70,13 +71,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   for (size_t i = 0; i < subjects.size(); ++i) {
     if (batch.outcomes[i].status != "ok") continue;
     const fs::path path = subjectDir(study_dir, subjects[i].id) / "results.json";
-    std::ifstream in(path);
-    nlohmann::json results;
-    try {
-      results = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-      throw ProcessingError("cannot read '" + path.string() + "': " + e.what());
-    }
+    const nlohmann::json results = readJsonFile(path, "study (" + subjects[i].id + ")");
     const std::string best = results.value("best_model", ""), selected = results.value("selected_model", "");
     std::string qc_status, qc_reasons;
     if (results.contains("qc") && results.at("qc").is_object()) {

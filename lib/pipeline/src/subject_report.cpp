@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "articula/core/json_file.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/number_text.hpp"
@@ -40,13 +41,9 @@ std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
 }
 
 json readStageJson(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError("cannot read '" + path.string() + "': " + e.what());
-  }
+  if (!fs::exists(path))
+    throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
+  return readJsonFile(path, "report");
 }
 
 // The checks of a head (pipeline/qc.hpp) on the articular points, their

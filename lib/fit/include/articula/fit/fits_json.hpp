@@ -20,11 +20,6 @@ nlohmann::json modelFitJson(const ModelFit& fit);
 /// missing or malformed key and `where` (e.g. the file name and index).
 geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where);
 
-/// Reads the JSON document of a fits.json file; throws InputError prefixed
-/// with `what` (the option that named the file, e.g. "--fits") when the file
-/// cannot be opened or is not valid JSON.
-nlohmann::json readFitsJson(const std::filesystem::path& path, const std::string& what);
-
 /// Every shape of a fits.json document, in file order.
 std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where);
 
