@@ -2,8 +2,6 @@
 // sampled triangle mesh (PLY, LPS mm, with outward unit normals and the
 // principal curvatures at every vertex), for 3D Slicer or ParaView.
 #include <cmath>
-#include <fstream>
-#include <iomanip>
 #include <limits>
 
 #include "articula/cli/command.hpp"
@@ -13,6 +11,7 @@
 #include "articula/core/provenance.hpp"
 #include "articula/geometry/curvature.hpp"
 #include "articula/geometry/surface.hpp"
+#include "articula/points/ply_writer.hpp"
 
 namespace articula::apps {
 namespace {
@@ -74,31 +73,21 @@ class SurfaceCommand : public cli::Command {
               " vertices, " + std::to_string(mesh.triangles.rows()) + " triangles");
 
     double max_abs_f = 0.0, k_min = std::numeric_limits<double>::infinity(), k_max = -k_min;
-    AtomicFile file(output_, common.force);
-    std::ostream& out = file.stream();
-    // Hand-written ASCII PLY: a few lines, and the VTK writers belong to the mesh module.
-    out << "ply\nformat ascii 1.0\n"
-        << "comment articula " << geometry::modelName(p.model) << " surface; coordinates LPS, units mm\n"
-        << "element vertex " << mesh.vertices.rows() << "\n"
-        << "property double x\nproperty double y\nproperty double z\n"
-        << "property double nx\nproperty double ny\nproperty double nz\n"
-        << "property double k1\nproperty double k2\n"
-        << "element face " << mesh.triangles.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
-    out << std::setprecision(12);
+    points::PlyData ply;
+    ply.comments = {"articula " + geometry::modelName(p.model) + " surface"};
+    for (const char* name : {"x", "y", "z", "nx", "ny", "nz", "k1", "k2"}) ply.vertex_properties.push_back({name});
+    ply.vertex_values.resize(mesh.vertices.rows(), 8);
+    ply.faces = mesh.triangles;
     for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i) {
       const Eigen::Vector3d x = mesh.vertices.row(i).transpose();
       const geometry::Evaluation e = surface->evaluate(x, 1);
       const geometry::PrincipalCurvatures pc = geometry::principalCurvatures(*surface, x);
-      const Eigen::Vector3d n = e.gradient.normalized();
       max_abs_f = std::max(max_abs_f, std::fabs(e.value));
       k_min = std::min(k_min, pc.k2);
       k_max = std::max(k_max, pc.k1);
-      out << x[0] << ' ' << x[1] << ' ' << x[2] << ' ' << n[0] << ' ' << n[1] << ' ' << n[2] << ' ' << pc.k1 << ' '
-          << pc.k2 << '\n';
+      ply.vertex_values.row(i) << x.transpose(), e.gradient.normalized().transpose(), pc.k1, pc.k2;
     }
-    for (Eigen::Index i = 0; i < mesh.triangles.rows(); ++i)
-      out << "3 " << mesh.triangles(i, 0) << ' ' << mesh.triangles(i, 1) << ' ' << mesh.triangles(i, 2) << '\n';
-    file.commit();
+    writeFileAtomically(output_, points::plyText(ply, points::PlyFormat::Ascii), common.force);
 
     nlohmann::json params = {{"model", geometry::modelName(p.model)}, {"resolution", resolution_}};
     const auto names = geometry::parameterNames(p.model);

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "articula/core/error.hpp"
+#include "articula/points/ply_writer.hpp"
 #include "articula/points/point_io.hpp"
 
 namespace fs = std::filesystem;
@@ -25,6 +26,7 @@ using articula::points::checkFittable;
 using articula::points::PointCloud;
 using articula::points::readPoints;
 using articula::points::writePoints;
+namespace points = articula::points;
 
 namespace {
 
@@ -328,6 +330,32 @@ TEST_F(PointsTest, ReadsTextNormalsPositionallyOrByName) {
 }
 
 // ---- errors -------------------------------------------------------------------------------------------
+
+// The one PLY writer, ASCII and binary, with uchar colours and triangles:
+// the reader gets the vertices back (12 digits in ASCII, every bit in
+// binary), past the colour properties and the face element.
+TEST_F(PointsTest, PlyWriterRoundTripsVerticesPastColoursAndFaces) {
+  points::PlyData data;
+  data.comments = {"two\nlines"};
+  data.vertex_properties = {{"x"}, {"y"}, {"z"}, {"red", true}, {"signed_distance_mm"}};
+  data.vertex_values.resize(3, 5);
+  data.vertex_values << 1.25, -2.5, 3.0, 255, 0.1, 0.1 / 3.0, 7, -8, 300, -0.2, 4, 5, 6.5, -1, 0;
+  data.faces.resize(1, 3);
+  data.faces << 0, 1, 2;
+  for (const auto format : {points::PlyFormat::Ascii, points::PlyFormat::BinaryLittleEndian}) {
+    const std::string bytes = points::plyText(data, format);
+    EXPECT_NE(bytes.find("comment coordinates LPS, units mm\ncomment two lines\n"), std::string::npos);
+    EXPECT_NE(bytes.find("property uchar red\n"), std::string::npos);
+    EXPECT_NE(bytes.find("element face 1\n"), std::string::npos);
+    const points::PointCloud back = points::readPoints(writeFile("round.ply", bytes));
+    ASSERT_EQ(back.positions.rows(), 3);
+    const double tolerance = format == points::PlyFormat::Ascii ? 1e-12 : 0.0;
+    EXPECT_LE((back.positions - data.vertex_values.leftCols(3)).cwiseAbs().maxCoeff(), tolerance);
+  }
+  const std::string ascii = points::plyText(data, points::PlyFormat::Ascii);
+  EXPECT_NE(ascii.find(" 7 -8 255 -0.2\n4 5 6.5 0 0\n"), std::string::npos) << "uchar clamped to 0-255: " << ascii;
+  EXPECT_NE(ascii.find("\n3 0 1 2\n"), std::string::npos);
+}
 
 TEST_F(PointsTest, MissingEmptyAndUnknownFilesAreInputErrors) {
   std::string m = readError(file("absent.ply"));

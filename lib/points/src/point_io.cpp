@@ -12,6 +12,7 @@
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/points/ply_writer.hpp"
 #include "readers.hpp"
 
 namespace articula::points {
@@ -44,16 +45,6 @@ void finishCloud(PointCloud& cloud, const std::filesystem::path& path,
 
 namespace {
 
-// Little-endian bytes of a double on any host.
-void appendLittleEndian(std::string& out, double value) {
-  std::array<char, sizeof(double)> bytes;
-  std::memcpy(bytes.data(), &value, sizeof(double));
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
-  std::reverse(bytes.begin(), bytes.end());
-#endif
-  out.append(bytes.data(), bytes.size());
-}
-
 // Shortest decimal text that reads back to the same double.
 void appendShortest(std::string& out, double value) {
   std::array<char, 32> buffer;
@@ -61,32 +52,16 @@ void appendShortest(std::string& out, double value) {
   out.append(buffer.data(), result.ptr);
 }
 
-// A comment must stay on its header line.
-std::string oneLine(std::string text) {
-  std::replace_if(
-      text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-  return text;
-}
-
 std::string plyBytes(const PointCloud& cloud, const std::vector<std::string>& comments) {
   const bool has_normals = cloud.normals.rows() > 0;
-  std::ostringstream header;
-  header << "ply\nformat binary_little_endian 1.0\ncomment coordinates LPS, units mm\n";
-  for (const auto& comment : comments) header << "comment " << oneLine(comment) << '\n';
-  header << "element vertex " << cloud.positions.rows() << '\n';
-  for (const char* name : {"x", "y", "z"}) header << "property double " << name << '\n';
-  if (has_normals)
-    for (const char* name : {"nx", "ny", "nz"}) header << "property double " << name << '\n';
-  header << "end_header\n";
-
-  std::string out = header.str();
-  out.reserve(out.size() + static_cast<std::size_t>(cloud.positions.rows()) * (has_normals ? 48 : 24));
-  for (Eigen::Index i = 0; i < cloud.positions.rows(); ++i) {
-    for (int k = 0; k < 3; ++k) appendLittleEndian(out, cloud.positions(i, k));
-    if (has_normals)
-      for (int k = 0; k < 3; ++k) appendLittleEndian(out, cloud.normals(i, k));
-  }
-  return out;
+  PlyData data;
+  data.comments = comments;
+  for (const char* name : {"x", "y", "z", "nx", "ny", "nz"})
+    if (has_normals || data.vertex_properties.size() < 3) data.vertex_properties.push_back({name});
+  data.vertex_values.resize(cloud.positions.rows(), has_normals ? 6 : 3);
+  data.vertex_values.leftCols(3) = cloud.positions;
+  if (has_normals) data.vertex_values.rightCols(3) = cloud.normals;
+  return plyText(data, PlyFormat::BinaryLittleEndian);
 }
 
 std::string csvText(const PointCloud& cloud) {

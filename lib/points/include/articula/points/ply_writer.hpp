@@ -1,0 +1,32 @@
+#pragma once
+// The project's one PLY writer: vertices with named double or uchar
+// properties, optional triangles, comments (the first always "coordinates
+// LPS, units mm", as 3D Slicer and ParaView read it), ASCII or binary
+// little-endian. Hand-written: a PLY header is a few lines, and VTK's writer
+// would bring VTK into every module that writes points.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace articula::points {
+
+struct PlyProperty {
+  std::string name;
+  bool uchar = false;  // else double
+};
+
+struct PlyData {
+  std::vector<std::string> comments;         // each on its own header line
+  std::vector<PlyProperty> vertex_properties;
+  Eigen::MatrixXd vertex_values;             // one row per vertex, one column per property
+  Eigen::MatrixX3i faces;                    // triangles, 0-based; no rows: no face element
+};
+
+enum class PlyFormat { Ascii, BinaryLittleEndian };
+
+/// The file's bytes. Doubles in ASCII have 12 significant digits (printf's
+/// %.12g); uchar values are rounded and clamped to 0-255.
+std::string plyText(const PlyData& data, PlyFormat format);
+
+}  // namespace articula::points
