@@ -10,7 +10,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/pipeline/batch.hpp"
-#include "articula/pipeline/csv.hpp"
+#include "articula/core/csv.hpp"
 #include "articula/pipeline/manifest.hpp"
 #include "articula/pipeline/markups.hpp"
 #include "articula/pipeline/statistics.hpp"
@@ -115,8 +115,8 @@ TEST(Statistics, SummariesAndInformationCriteria) {
 TEST(Csv, QuotedFieldsRoundTrip) {
   const fs::path dir = scratch("csv");
   const std::vector<std::string> fields = {"plain", "with,comma", "with \"quotes\"", "", "multi\nline"};
-  write(dir / "t.csv", "a,b,c,d,e\n" + p::csvLine(fields) + "\n# comment\n\n1,2\n");
-  const p::CsvTable t = p::readCsv(dir / "t.csv");
+  write(dir / "t.csv", "a,b,c,d,e\n" + articula::csvLine(fields) + "\n# comment\n\n1,2\n");
+  const articula::CsvTable t = articula::readCsv(dir / "t.csv");
   ASSERT_EQ(t.rows.size(), 2u);
   EXPECT_EQ(t.rows[0], fields);
   EXPECT_EQ(t.rows[1][1], "2");
@@ -124,7 +124,7 @@ TEST(Csv, QuotedFieldsRoundTrip) {
   EXPECT_EQ(t.row_lines[1], 6);
   write(dir / "bad.csv", "a,b\n1,2,3\n");
   try {
-    p::readCsv(dir / "bad.csv");
+    articula::readCsv(dir / "bad.csv");
     FAIL();
   } catch (const articula::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:2"), std::string::npos) << e.what();

@@ -4,13 +4,12 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
 
+#include "articula/core/csv.hpp"
 #include "articula/core/error.hpp"
 
 namespace articula::contact {
@@ -18,20 +17,6 @@ namespace articula::contact {
 namespace {
 
 using Eigen::Vector3d;
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r"), e = s.find_last_not_of(" \t\r");
-  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
 
 // A row that cannot be used; its message becomes PairRow::reason.
 struct BadRow : std::runtime_error {
@@ -116,13 +101,10 @@ void parseRow(PairRow& pair, const std::map<std::string, size_t>& columns, const
 }  // namespace
 
 std::vector<PairRow> readPairsCsv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read --pairs file '" + path.string() + "'");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(path.string() + ": empty file (expected a header row)");
+  // Rows as read: a row of the wrong length is that row's problem, not the file's.
+  const CsvTable table = readCsv(path, {true});
   std::map<std::string, size_t> columns;
-  const auto header = splitCsv(line);
-  for (size_t i = 0; i < header.size(); ++i) columns[header[i]] = i;
+  for (size_t i = 0; i < table.header.size(); ++i) columns[table.header[i]] = i;
   std::vector<std::string> missing;
   for (const char* s : {"a", "b"})
     for (const char* c : {"cx", "cy", "cz"})
@@ -136,12 +118,11 @@ std::vector<PairRow> readPairsCsv(const std::filesystem::path& path) {
   }
 
   std::vector<PairRow> rows;
-  for (int line_no = 2; std::getline(in, line); ++line_no) {
-    if (trim(line).empty()) continue;
+  for (size_t i = 0; i < table.rows.size(); ++i) {
     PairRow& pair = rows.emplace_back();
-    pair.line = line_no;
+    pair.line = table.row_lines[i];
     try {
-      parseRow(pair, columns, splitCsv(line), header.size());
+      parseRow(pair, columns, table.rows[i], table.header.size());
       pair.valid = true;
     } catch (const BadRow& e) {
       pair.reason = e.what();

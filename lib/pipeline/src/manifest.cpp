@@ -4,7 +4,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
-#include "articula/pipeline/csv.hpp"
+#include "articula/core/csv.hpp"
 
 namespace articula::pipeline {
 

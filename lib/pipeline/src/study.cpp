@@ -10,7 +10,7 @@
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
-#include "articula/pipeline/csv.hpp"
+#include "articula/core/csv.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/report/study_svg.hpp"
 

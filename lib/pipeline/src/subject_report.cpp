@@ -16,7 +16,7 @@
 #include "articula/fit/fits_json.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/shape.hpp"
-#include "articula/pipeline/csv.hpp"
+#include "articula/core/csv.hpp"
 #include "articula/pipeline/markups.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/points/point_io.hpp"

@@ -1,10 +1,10 @@
-#include "articula/pipeline/csv.hpp"
+#include "articula/core/csv.hpp"
 
 #include <fstream>
 
 #include "articula/core/error.hpp"
 
-namespace articula::pipeline {
+namespace articula {
 
 int CsvTable::column(const std::string& name) const {
   for (size_t i = 0; i < header.size(); ++i)
@@ -64,7 +64,7 @@ std::vector<std::string> splitRecord(std::string line, std::istream& in, int& li
 }
 }  // namespace
 
-CsvTable readCsv(const std::filesystem::path& path) {
+CsvTable readCsv(const std::filesystem::path& path, const CsvReadOptions& options) {
   std::ifstream in(path);
   if (!in) throw InputError("cannot read '" + path.string() + "': expected a CSV file");
   CsvTable table;
@@ -84,11 +84,12 @@ CsvTable readCsv(const std::filesystem::path& path) {
       have_header = true;
       continue;
     }
-    if (fields.size() > table.header.size())
+    table.row_field_counts.push_back(fields.size());
+    if (!options.rows_as_read && fields.size() > table.header.size())
       throw InputError(path.string() + ":" + std::to_string(record_line) + ": expected at most " +
                        std::to_string(table.header.size()) + " fields (the header's), found " +
                        std::to_string(fields.size()));
-    fields.resize(table.header.size());
+    if (!options.rows_as_read) fields.resize(table.header.size());
     table.rows.push_back(std::move(fields));
     table.row_lines.push_back(record_line);
   }
@@ -115,4 +116,4 @@ std::string csvLine(const std::vector<std::string>& fields) {
   return out;
 }
 
-}  // namespace articula::pipeline
+}  // namespace articula
