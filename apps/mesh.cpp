@@ -39,6 +39,7 @@ class MeshCommand : public cli::Command {
         ->capture_default_str();
   }
   int run(const cli::CommonOptions& common) override {
+    imaging::limitImagingThreads(common.threadCount());
     options_.smoothing = smoothing_ == "laplacian" ? mesh::Smoothing::Laplacian
                          : smoothing_ == "sinc"    ? mesh::Smoothing::WindowedSinc
                                                    : mesh::Smoothing::None;

@@ -56,6 +56,7 @@ class PhantomCommand : public cli::Command {
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
+    imaging::limitImagingThreads(common.threadCount());
     phantom::PhantomOptions o;
     if (osteoporotic_) o.makeOsteoporotic();
     // Explicit bone options override the osteoporotic preset.

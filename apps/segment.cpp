@@ -50,6 +50,7 @@ class SegmentCommand : public cli::Command {
     app.add_option("--max-radius", options_.max_head_radius_mm, "Largest plausible head radius (mm)")->capture_default_str();
   }
   int run(const cli::CommonOptions& common) override {
+    imaging::limitImagingThreads(common.threadCount());
     options_.joint = joint_ == "hip" ? imaging::Joint::Hip : imaging::Joint::Shoulder;
     options_.side = side_ == "right" ? imaging::Side::Right : imaging::Side::Left;
     if (!seed_point_.empty()) options_.seed_point = Eigen::Vector3d(seed_point_[0], seed_point_[1], seed_point_[2]);

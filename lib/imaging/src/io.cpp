@@ -14,6 +14,7 @@
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
 #include <itkImage.h>
+#include <itkMultiThreaderBase.h>
 #include <cerrno>
 #include <cstdint>
 #include <itkImageFileReader.h>
@@ -424,6 +425,12 @@ std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
   if (out.empty())
     throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)");
   return out;
+}
+
+void limitImagingThreads(int threads) {
+  const auto n = static_cast<itk::ThreadIdType>(std::max(1, threads));
+  itk::MultiThreaderBase::SetGlobalMaximumNumberOfThreads(n);
+  itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(n);
 }
 
 struct VolumeMemory::Kept {

@@ -50,6 +50,10 @@ std::vector<SeriesInfo> listDicomSeries(const std::filesystem::path& folder);
 /// non-orthonormal direction matrix.
 Volume readVolume(const std::filesystem::path& input, const ReadOptions& options, ReadReport* report = nullptr);
 
+/// ITK's filters use at most `threads` threads (ITK's own pool otherwise
+/// takes every core, whatever --threads says).
+void limitImagingThreads(int threads);
+
 /// While one is alive, readVolume keeps the last volume it read and answers
 /// the same input read again with the same options from memory, provided its
 /// files are unchanged (names, sizes and modification times): `articula run`
