@@ -373,6 +373,17 @@ struct Solver {
   }
 };
 
+// Whether a stationary point of the dual with value s is its global maximum.
+// Each body is a convex body plus a ball of its least radius of curvature
+// (leastRadiusOfCurvature), so along every great circle s'' + s <= -k with
+// k the sum of the two radii, and from a stationary point (Sturm comparison)
+// s(phi) <= (s + k) cos phi - k, below s elsewhere once s + k > 0. The margin
+// is the ellipsoid path's: what a gradient at the tolerance could add elsewhere
+// stays at rounding level.
+bool certifiedByCurvature(const ConvexShape& a, const ConvexShape& b, double s, double length) {
+  return s + leastRadiusOfCurvature(a) + leastRadiusOfCurvature(b) > 1e-4 * length;
+}
+
 }  // namespace
 
 ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const ContactOptions& options,
@@ -382,24 +393,44 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
   options.validate();
   ContactResult result;
   ContactSummary& summary = result.summary;
-  bool hill_climb_answer = false;
+  bool hill_climb_answer = false, certified_overlap = false;
   Solver solver{a, b, options, std::max(boundingRadius(a), boundingRadius(b)), summary};
+  // A converged start's overlap that the curvature certificate proves global.
+  auto certifiesOverlap = [&](double s) {
+    certified_overlap = options.curvature_certificate && certifiedByCurvature(a, b, s, solver.length);
+    return certified_overlap;
+  };
 
   double distance = 0.0;
   bool done = false;
   if (warm_start) {
     summary.warm_started = true;
-    if (solver.newton(warm_start->canonical_a, warm_start->canonical_b, &distance))
-      done = distance > 0.0 || !options.verify_warm_overlap;
-    if (done) summary.termination = distance > 0.0 ? "warm start, separated" : "warm start, local solution kept";
+    if (solver.newton(warm_start->canonical_a, warm_start->canonical_b, &distance)) {
+      if (distance > 0.0) {
+        done = true;
+        summary.termination = "warm start, separated";
+      } else if (!options.verify_warm_overlap) {
+        done = true;
+        summary.termination = "warm start, local solution kept";
+      } else if (certifiesOverlap(distance)) {
+        done = true;
+        summary.termination = "warm start, overlap within the curvature bound (curvature certificate)";
+      }
+    }
   }
   if (!done) {
-    // Cold start from the centre-to-centre direction: a separated answer is final.
+    // Cold start from the centre-to-centre direction: a separated answer is
+    // final, and so is an overlap within the curvature bound.
     Vector3d v = b.center - a.center;
     v = v.norm() > 0.0 ? Vector3d(v.normalized()) : Vector3d::UnitX();
-    if (solver.startFromDirection(v, &distance) && distance > 0.0) {
-      done = true;
-      summary.termination = "separated (dual certificate)";
+    if (solver.startFromDirection(v, &distance)) {
+      if (distance > 0.0) {
+        done = true;
+        summary.termination = "separated (dual certificate)";
+      } else if (certifiesOverlap(distance)) {
+        done = true;
+        summary.termination = "overlap within the curvature bound (curvature certificate)";
+      }
     }
   }
   if (!done) {
@@ -446,6 +477,9 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
     if (!summary.termination)
       summary.termination = solver.best > 0.0 ? "separated (dual certificate, after global search)"
                                               : "overlap: best of the global search";
+    // The search's answer may lie above -k where the first start's did not.
+    if (!hill_climb_answer && solver.best <= 0.0)
+      certified_overlap = certifiedByCurvature(a, b, solver.best, solver.length);
   }
   if (!hill_climb_answer) summary.status = ContactStatus::Converged;
 
@@ -456,7 +490,7 @@ ContactResult computeContact(const ConvexShape& a, const ConvexShape& b, const C
   result.normal = solver.best_normal;
   const Vector3d d = result.point_b - result.point_a;
   result.distance = std::copysign(d.norm(), result.normal.dot(d));
-  summary.certified = result.distance > 0.0 && summary.status == ContactStatus::Converged;
+  summary.certified = (result.distance > 0.0 || certified_overlap) && summary.status == ContactStatus::Converged;
   summary.residual = solver.best_residual;
   return result;
 }

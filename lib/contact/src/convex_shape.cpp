@@ -184,6 +184,40 @@ Vector3d supportCanonical(const ConvexShape& s, const Vector3d& v) {
   return u;
 }
 
+// With t_i = |u_i|^g_i on the surface (sum t_i = 1), the Hessian of F in
+// global coordinates has eigenvalues H_j / r_j^2 = g_j (g_j - 1) t_j^(1 - 2/g_j) / r_j^2
+// and the gradient's length is |D^-1 grad F| = sqrt(sum_i (g_i / r_i)^2 t_i^(2 - 2/g_i)),
+// so every principal curvature is at most max_j (H_j / r_j^2) / |D^-1 grad F|.
+// For each j the radius |D^-1 grad F| r_j^2 / H_j is bounded below by the
+// larger of its own-component term r_j t_j^(1/g_j) / (g_j - 1) (increasing in
+// t_j) and G r_j^2 / H_j (decreasing), G the least gradient length; the
+// smaller of the two curves' crossing and the value at t_j = 1 bounds it.
+double leastRadiusOfCurvature(const ConvexShape& s) {
+  // G^2 >= min over the simplex of sum c_i t_i^P, c_i = (g_i / r_i)^2, P the
+  // largest 2 - 2/g_i (t_i <= 1); by Lagrange that minimum is
+  // c_min (sum (c_i / c_min)^(-1/(P-1)))^-(P-1), c_min for P = 1 (ellipsoids).
+  double c[3], power = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    c[i] = (s.exponents[i] / s.radii[i]) * (s.exponents[i] / s.radii[i]);
+    power = std::max(power, 2.0 - 2.0 / s.exponents[i]);
+  }
+  const double c_min = std::min({c[0], c[1], c[2]});
+  double g2 = c_min;
+  if (power > 1.0) {
+    double sum = 0.0;
+    for (double ci : c) sum += std::pow(ci / c_min, -1.0 / (power - 1.0));
+    g2 = c_min * std::pow(sum, -(power - 1.0));
+  }
+  const double gradient = std::sqrt(g2);
+  double radius = INFINITY;
+  for (int j = 0; j < 3; ++j) {
+    const double g = s.exponents[j], r = s.radii[j], crossing = gradient * r / g;  // t* = crossing^(g / (g - 1))
+    radius = std::min(radius, crossing <= 1.0 ? r * std::pow(crossing, 1.0 / (g - 1.0)) / (g - 1.0)
+                                              : gradient * r * r / (g * (g - 1.0)));
+  }
+  return radius;
+}
+
 double boundingRadius(const ConvexShape& s) { return s.quadric ? s.radii.maxCoeff() : s.radii.norm(); }
 
 }  // namespace articula::contact

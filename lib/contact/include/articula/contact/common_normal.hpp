@@ -14,10 +14,13 @@
 //   s(v) = v . (c_B - c_A) - h_A(v) - h_B(-v),   signed distance = max_|v|=1 s(v)
 // has, at a common-normal pair with opposite normals, s(n_A) = n_A . d and a
 // stationary point. s is concave and 1-homogeneous, so a stationary point with
-// s > 0 is the global maximum: a separated answer is certified. Otherwise
-// (overlap) the dual is sampled over the sphere and Newton is started from
-// the best distinct directions; the answer is the largest s found (the
-// minimum penetration depth). Newton is damped by a backtracking line search;
+// s > 0 is the global maximum: a separated answer is certified. So is an
+// overlap shallower than k, the sum of the bodies' least radii of curvature
+// (leastRadiusOfCurvature): each body is a convex body plus a ball of that
+// radius, and a stationary point with s > -k is the dual's only maximum.
+// Otherwise (deeper overlap) the dual is sampled over the sphere and Newton
+// is started from the best distinct directions; the answer is the largest s
+// found (the minimum penetration depth). Newton is damped by a backtracking line search;
 // on a singular Jacobian or a rejected step it takes Levenberg-Marquardt
 // steps; when every start stalls, a hill climb on the dual gives the start.
 // Signed distance (table 5.2): d = sign(n_A . d_AB) |d_AB|, > 0 apart, < 0 overlap.
@@ -47,16 +50,17 @@ struct ContactOptions {
   int sample_directions = 64;       // dual samples for the global search (overlap)
   int global_starts = 3;            // common-normal system: Newton starts from the best distinct samples
   bool verify_warm_overlap = false;  // warm start and overlap: also run the global search
-  // Ellipsoid pairs: an overlap shallower than the bodies' least radii of
-  // curvature is certified without the global search (ellipsoid_contact.hpp);
-  // false searches anyway (to check the certificate).
+  // An overlap shallower than the bodies' least radii of curvature is
+  // certified without the global search (ellipsoid pairs: ellipsoid_contact.hpp;
+  // others: the first Newton start's answer, and with verify_warm_overlap a
+  // warm start's); false searches anyway (to check the certificate).
   bool curvature_certificate = true;
   /// Throws UsageError naming the first bad field.
   void validate() const;
 };
 
 enum class ContactStatus {
-  Converged,     // Newton converged; separated answers (and shallow ellipsoid overlaps) are certified global
+  Converged,     // Newton converged; separated answers (and overlaps above -k) are certified global
   NotConverged,  // no Newton start converged: the answer is the dual hill climb's
 };
 const char* statusName(ContactStatus status);  // "converged", "not_converged"
@@ -70,7 +74,8 @@ struct ContactSummary {
   bool warm_started = false;
   bool global_search = false;  // the dual was sampled
   bool certified = false;      // the answer is proven the dual's global maximum: separated (concavity), or
-                               // two ellipsoids overlapping less than their least radii of curvature (ellipsoid_contact.hpp)
+                               // an overlap shallower than the bodies' least radii of curvature (cold, or
+                               // searched; a warm overlap only with verify_warm_overlap)
   double residual = 0.0;       // |Phi| at the answer
   std::string briefReport() const;
 };

@@ -64,6 +64,12 @@ inline Eigen::Vector3d toCanonical(const ConvexShape& s, const Eigen::Vector3d& 
 /// (converges from the right, to rounding, in a few steps).
 Eigen::Vector3d supportCanonical(const ConvexShape& s, const Eigen::Vector3d& v);
 
+/// A lower bound of the least principal radius of curvature of the surface
+/// (exact for ellipsoids: r_min^2 / r_max). By Blaschke's rolling theorem the
+/// body is then another convex body plus a ball of this radius, which is what
+/// the overlap certificate of computeContact rests on.
+double leastRadiusOfCurvature(const ConvexShape& s);
+
 /// Radius of the smallest sphere about the centre holding the body
 /// (for a superellipsoid with exponents >= 2: |radii|, a bound; exact for quadrics: max radius).
 double boundingRadius(const ConvexShape& s);
