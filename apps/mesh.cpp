@@ -60,9 +60,9 @@ class MeshCommand : public cli::Command {
     if (!ct_.empty()) {
       imaging::ReadOptions read;
       read.series_uid = series_uid_;
-      const imaging::Volume ct = imaging::readVolume(ct_, read);
+      const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(ct_, read);
       mesh::EdgeSnapSummary snapped;
-      mesh::snapToEdges(m, ct, snap_, &snapped);
+      mesh::snapToEdges(m, *ct, snap_, &snapped);
       const double share = snapped.vertices ? static_cast<double>(snapped.on_edge) / snapped.vertices : 0.0;
       edges = {{"ct", ct_.string()},
                {"moved", snapped.moved},

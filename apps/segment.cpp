@@ -67,7 +67,8 @@ class SegmentCommand : public cli::Command {
     imaging::ReadOptions read;
     read.series_uid = series_uid_;
     imaging::ReadReport report;
-    const imaging::Volume ct = imaging::readVolume(input_, read, &report);
+    const std::shared_ptr<const imaging::Volume> shared_ct = imaging::readSharedVolume(input_, read, &report);
+    const imaging::Volume& ct = *shared_ct;
     for (const auto& w : report.warnings) log::warn(w);
     const auto& g = ct.geometry;
     log::info("read " + input_.string() + ": " + std::to_string(g.size[0]) + "x" + std::to_string(g.size[1]) + "x" +

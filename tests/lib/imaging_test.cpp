@@ -68,17 +68,20 @@ TEST(ImagingIo, VolumeMemoryAnswersARepeatedReadUntilTheFileChanges) {
     const imaging::Volume again = imaging::readVolume(dir / "ct.nii.gz", {});
     EXPECT_EQ(memory.hits(), 1);
     EXPECT_EQ(first.voxels, again.voxels);
+    // Shared reads hand out the kept volume itself, not a copy.
+    EXPECT_EQ(imaging::readSharedVolume(dir / "ct.nii.gz", {}), imaging::readSharedVolume(dir / "ct.nii.gz", {}));
+    EXPECT_EQ(memory.hits(), 3);
     imaging::ReadOptions other;
     other.spacing_tolerance = 0.02;
     imaging::readVolume(dir / "ct.nii.gz", other);  // other options: another read
-    EXPECT_EQ(memory.hits(), 1);
+    EXPECT_EQ(memory.hits(), 3);
     imaging::Volume changed = p.ct;
     for (float& v : changed.voxels) v += 100;
     imaging::writeVolume(dir / "ct.nii.gz", changed);
     std::filesystem::last_write_time(dir / "ct.nii.gz", std::filesystem::last_write_time(dir / "ct.nii.gz") +
                                                             std::chrono::seconds(2));
     const imaging::Volume reread = imaging::readVolume(dir / "ct.nii.gz", other);
-    EXPECT_EQ(memory.hits(), 1);
+    EXPECT_EQ(memory.hits(), 3);
     EXPECT_NEAR(reread.voxels[0], first.voxels[0] + 100, 0.5);
     EXPECT_THROW(imaging::VolumeMemory second, ProcessingError);  // one at a time
   }

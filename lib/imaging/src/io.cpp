@@ -435,7 +435,7 @@ void limitImagingThreads(int threads) {
 
 struct VolumeMemory::Kept {
   std::string key;  // the input, its options and its files' fingerprint
-  Volume volume;
+  std::shared_ptr<const Volume> volume;
   ReadReport report;
   long long hits = 0;
 };
@@ -486,10 +486,11 @@ VolumeMemory::~VolumeMemory() {
 
 long long VolumeMemory::hits() const { return kept_->hits; }
 
-Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport* report_out) {
+std::shared_ptr<const Volume> readSharedVolume(const fs::path& input, const ReadOptions& options,
+                                               ReadReport* report_out) {
   if (!g_volume_memory) {
     ReadReport report;
-    Volume volume = readVolumeFromFiles(input, options, report);
+    auto volume = std::make_shared<const Volume>(readVolumeFromFiles(input, options, report));
     if (report_out) *report_out = report;
     return volume;
   }
@@ -499,11 +500,16 @@ Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport*
     ++kept.hits;
   } else {
     kept.key.clear();  // a failed read keeps nothing
-    kept.volume = readVolumeFromFiles(input, options, kept.report);
+    kept.volume.reset();
+    kept.volume = std::make_shared<const Volume>(readVolumeFromFiles(input, options, kept.report));
     kept.key = key;
   }
   if (report_out) *report_out = kept.report;
   return kept.volume;
+}
+
+Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport* report_out) {
+  return *readSharedVolume(input, options, report_out);
 }
 
 namespace {
@@ -533,6 +539,14 @@ Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, Re
 Label readLabel(const fs::path& input) {
   if (!fs::is_regular_file(input)) throw InputError("label image not found: " + input.string());
   if (!isImageFile(input)) throw InputError("expected a label image (.nii.gz/.nrrd/.mha), found " + input.string());
+  // A uint8 label (as articula writes them) is read as it is stored: a float
+  // copy of a CT-sized label is four times the memory and time.
+  if (storedComponentType(input) == itk::IOComponentEnum::UCHAR) {
+    Label label = readImageFile<std::uint8_t>(input);
+    checkDirection(label.geometry.direction, input.string());
+    for (auto& v : label.voxels) v = v != 0 ? 1 : 0;
+    return label;
+  }
   const Image<float> raw = readImageFile<float>(input);
   checkDirection(raw.geometry.direction, input.string());
   Label label;

@@ -76,6 +76,19 @@ Image<T> fromItk(const itk::Image<U, 3>* image) {
 /// Other formats: no-op.
 void checkNiftiFile(const std::filesystem::path& path);
 
+/// The pixel type an image file stores (UNKNOWNCOMPONENTTYPE when ITK has no reader for it).
+inline itk::IOComponentEnum storedComponentType(const std::filesystem::path& path) {
+  auto io = itk::ImageIOFactory::CreateImageIO(path.string().c_str(), itk::CommonEnums::IOFileMode::ReadMode);
+  if (!io) return itk::IOComponentEnum::UNKNOWNCOMPONENTTYPE;
+  try {
+    io->SetFileName(path.string());
+    io->ReadImageInformation();
+  } catch (const itk::ExceptionObject&) {
+    return itk::IOComponentEnum::UNKNOWNCOMPONENTTYPE;  // readImageFile says why
+  }
+  return io->GetComponentType();
+}
+
 template <typename T>
 Image<T> readImageFile(const std::filesystem::path& path) {
   checkNiftiFile(path);

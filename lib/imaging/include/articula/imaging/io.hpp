@@ -2,6 +2,7 @@
 // Reading CT volumes and labels (DICOM series, NIfTI, NRRD, MHA) with the
 // checks ITK does not make, and writing them back. Everything in LPS mm.
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,11 @@ std::vector<SeriesInfo> listDicomSeries(const std::filesystem::path& folder);
 /// slice spacing or missing slices, gantry tilt, a non-CT modality, or a
 /// non-orthonormal direction matrix.
 Volume readVolume(const std::filesystem::path& input, const ReadOptions& options, ReadReport* report = nullptr);
+
+/// The same without a copy: while a VolumeMemory is alive, the kept volume
+/// itself (a CT is hundreds of megabytes).
+std::shared_ptr<const Volume> readSharedVolume(const std::filesystem::path& input, const ReadOptions& options,
+                                               ReadReport* report = nullptr);
 
 /// ITK's filters use at most `threads` threads (ITK's own pool otherwise
 /// takes every core, whatever --threads says).
