@@ -242,19 +242,19 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
 }
 
 ClosestPoint SignedDistance::closestExactFrom(const Vector3d& x, const Vector3d& guess) const {
-  if (isQuadric(shape_.model)) return closest(x);
-  const Vector3d y = rotation_.transpose() * (x - pose_.translation);
-  ClosestPoint c;
-  if (!newton(y, rotation_.transpose() * (guess - pose_.translation), c) || !(c.distance > 0.0)) return closest(x);
-  c.point = rotation_ * c.point + pose_.translation;
-  return c;
+  return refineFrom(x, guess, true);
 }
 
 ClosestPoint SignedDistance::closestFrom(const Vector3d& x, const Vector3d& guess) const {
+  return refineFrom(x, guess, false);
+}
+
+ClosestPoint SignedDistance::refineFrom(const Vector3d& x, const Vector3d& guess, bool outside_only) const {
   if (isQuadric(shape_.model)) return closest(x);
   const Vector3d y = rotation_.transpose() * (x - pose_.translation);
   ClosestPoint c;
-  if (!newton(y, rotation_.transpose() * (guess - pose_.translation), c)) return closest(x);
+  if (!newton(y, rotation_.transpose() * (guess - pose_.translation), c) || (outside_only && !(c.distance > 0.0)))
+    return closest(x);
   c.point = rotation_ * c.point + pose_.translation;
   return c;
 }

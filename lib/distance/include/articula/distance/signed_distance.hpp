@@ -66,6 +66,8 @@ class SignedDistance {
 
  private:
   bool newton(const Eigen::Vector3d& x, const Eigen::Vector3d& start, ClosestPoint& result) const;
+  /// Newton from `guess`, else (or, with outside_only, for a point not outside) closest().
+  ClosestPoint refineFrom(const Eigen::Vector3d& x, const Eigen::Vector3d& guess, bool outside_only) const;
   ClosestPoint descent(const Eigen::Vector3d& x, const Eigen::Vector3d& start) const;
   Eigen::Vector3d radialProjection(const Eigen::Vector3d& x) const;
 
