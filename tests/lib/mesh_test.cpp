@@ -1,6 +1,8 @@
 // Mesh: the iso-surface of the phantom's femur lands on the true head surface
 // in LPS, whether the grid is stored LPS or RAS (no mirroring, no shift),
 // with outward normals; file round trips; an empty label is refused.
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
@@ -81,6 +83,12 @@ TEST(Mesh, FileRoundTripsKeepVerticesAndTriangles) {
     // STL stores floats and repeats vertices per triangle: compare the extent.
     EXPECT_LT((back.vertices.colwise().minCoeff() - m.vertices.colwise().minCoeff()).norm(), 1e-3);
     EXPECT_LT((back.vertices.colwise().maxCoeff() - m.vertices.colwise().maxCoeff()).norm(), 1e-3);
+    // The frame as 3D Slicer reads it from each format's header.
+    std::ifstream in(path, std::ios::binary);
+    std::string head(4096, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    const std::string space = std::string(ext) == ".vtp" ? "Name=\"SPACE\"" : "SPACE=LPS";
+    EXPECT_NE(head.find(space), std::string::npos) << head.substr(0, 300);
   }
   EXPECT_THROW(mesh::writeMesh(dir / "m.obj", m), UsageError);
   EXPECT_THROW(mesh::readMesh(dir / "missing.vtp"), InputError);

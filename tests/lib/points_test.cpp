@@ -344,7 +344,7 @@ TEST_F(PointsTest, PlyWriterRoundTripsVerticesPastColoursAndFaces) {
   data.faces << 0, 1, 2;
   for (const auto format : {points::PlyFormat::Ascii, points::PlyFormat::BinaryLittleEndian}) {
     const std::string bytes = points::plyText(data, format);
-    EXPECT_NE(bytes.find("comment coordinates LPS, units mm\ncomment two lines\n"), std::string::npos);
+    EXPECT_NE(bytes.find("comment SPACE=LPS\ncomment coordinates LPS, units mm\ncomment two lines\n"), std::string::npos);
     EXPECT_NE(bytes.find("property uchar red\n"), std::string::npos);
     EXPECT_NE(bytes.find("element face 1\n"), std::string::npos);
     const points::PointCloud back = points::readPoints(writeFile("round.ply", bytes));

@@ -23,6 +23,8 @@
 #include <vtkSTLWriter.h>
 #include <vtkSmartPointer.h>
 #include <vtkSmoothPolyDataFilter.h>
+#include <vtkStringArray.h>
+#include <vtkFieldData.h>
 #include <vtkTriangleFilter.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowedSincPolyDataFilter.h>
@@ -288,6 +290,13 @@ void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
   fs::create_directories(folder, ec);
   const fs::path temp = temporaryPathFor(path);
   const vtkSmartPointer<vtkPolyData> poly = toVtk(mesh);
+  // How 3D Slicer learns a mesh's frame: "SPACE=LPS" in an STL header or a
+  // PLY comment, a string array SPACE in VTK field data (without it Slicer
+  // assumes LPS too, but says so only in its log).
+  vtkNew<vtkStringArray> space;
+  space->SetName("SPACE");
+  space->InsertNextValue("LPS");
+  poly->GetFieldData()->AddArray(space);
   int ok = 0;
   if (ext == ".vtp") {
     vtkNew<vtkXMLPolyDataWriter> w;
@@ -300,13 +309,14 @@ void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
     w->SetInputData(poly);
     w->SetFileName(temp.c_str());
     w->SetFileTypeToBinary();
-    w->SetHeader("articula mesh; coordinates LPS, units mm");
+    w->SetHeader("articula mesh SPACE=LPS; coordinates LPS, units mm");
     ok = w->Write();
   } else if (ext == ".ply") {
     vtkNew<vtkPLYWriter> w;
     w->SetInputData(poly);
     w->SetFileName(temp.c_str());
     w->SetFileTypeToBinary();
+    w->AddComment("SPACE=LPS");
     w->AddComment("articula mesh; coordinates LPS, units mm");
     ok = w->Write();
   } else {

@@ -40,7 +40,7 @@ std::string plyText(const PlyData& data, PlyFormat format) {
                                 std::to_string(columns) + " properties");
   const bool binary = format == PlyFormat::BinaryLittleEndian;
   std::string out = binary ? "ply\nformat binary_little_endian 1.0\n" : "ply\nformat ascii 1.0\n";
-  out += "comment coordinates LPS, units mm\n";
+  out += "comment SPACE=LPS\ncomment coordinates LPS, units mm\n";  // the first as 3D Slicer reads it
   for (const auto& comment : data.comments) out += "comment " + oneLine(comment) + "\n";
   out += "element vertex " + std::to_string(data.vertex_values.rows()) + "\n";
   for (const auto& p : data.vertex_properties) out += std::string("property ") + (p.uchar ? "uchar " : "double ") + p.name + "\n";

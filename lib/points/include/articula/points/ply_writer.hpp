@@ -1,7 +1,7 @@
 #pragma once
 // The project's one PLY writer: vertices with named double or uchar
-// properties, optional triangles, comments (the first always "coordinates
-// LPS, units mm", as 3D Slicer and ParaView read it), ASCII or binary
+// properties, optional triangles, comments (first always "SPACE=LPS", as 3D
+// Slicer reads a mesh's frame, and "coordinates LPS, units mm"), ASCII or binary
 // little-endian. Hand-written: a PLY header is a few lines, and VTK's writer
 // would bring VTK into every module that writes points.
 #include <string>
