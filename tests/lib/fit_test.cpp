@@ -256,10 +256,16 @@ TEST(FitHierarchy, DeterministicForAFixedSeed) {
   o.strategy = articula::fit::Strategy::GlobalLocal;
   o.global_evaluations = 300;
   o.seed = 9;
-  const Summary a = articula::fit::fitHierarchy(pts, o), b = articula::fit::fitHierarchy(pts, o);
+  // The starts are screened over the threads: one thread or four, the same fits.
+  articula::setWorkerThreads(1);
+  const Summary a = articula::fit::fitHierarchy(pts, o);
+  articula::setWorkerThreads(4);
+  const Summary b = articula::fit::fitHierarchy(pts, o);
+  articula::setWorkerThreads(0);
   for (size_t i = 0; i < a.fits.size(); ++i) {
     EXPECT_EQ(articula::geometry::toVector(a.fits[i].parameters), articula::geometry::toVector(b.fits[i].parameters));
     EXPECT_EQ(a.fits[i].evaluations, b.fits[i].evaluations);
+    EXPECT_EQ(a.fits[i].started_from, b.fits[i].started_from);
   }
   expectNested(a);
 }

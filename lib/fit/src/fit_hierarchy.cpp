@@ -13,6 +13,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/core/parallel.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/fit/levenberg_marquardt.hpp"
@@ -542,14 +543,23 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
     short_run.strategy = Strategy::Local;
     std::vector<std::pair<double, Start>> screened;
     const Eigen::MatrixX3d screen_points = subsample(points, o.screening_points);
-    for (const Start& start : starts) {
-      const auto [x0, b] = prepareStart(model, start.shape, model_bounds);
-      const Eigen::MatrixX3d feet = start.feet.rows() == points.rows() ? subsample(start.feet, o.screening_points)
-                                                                         : Eigen::MatrixX3d();
-      const RunResult r =
-          runLocal(model, x0, b, initialSteps(model, start.shape), screen, screen_points, feet, short_run);
-      screening_evaluations += r.evaluations;
-      if (std::isfinite(r.value)) screened.push_back({r.value, {start.label, geometry::fromVector(model, r.x), {}}});
+    // The starts are independent: screened side by side over --threads, then
+    // taken in their order (the same answer for any thread count).
+    std::vector<RunResult> runs(starts.size());
+    parallelFor(static_cast<std::ptrdiff_t>(starts.size()), 1, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+      for (std::ptrdiff_t i = begin; i < end; ++i) {
+        const Start& start = starts[static_cast<size_t>(i)];
+        const auto [x0, b] = prepareStart(model, start.shape, model_bounds);
+        const Eigen::MatrixX3d feet = start.feet.rows() == points.rows() ? subsample(start.feet, o.screening_points)
+                                                                           : Eigen::MatrixX3d();
+        runs[static_cast<size_t>(i)] =
+            runLocal(model, x0, b, initialSteps(model, start.shape), screen, screen_points, feet, short_run);
+      }
+    });
+    for (size_t i = 0; i < starts.size(); ++i) {
+      screening_evaluations += runs[i].evaluations;
+      if (std::isfinite(runs[i].value))
+        screened.push_back({runs[i].value, {starts[i].label, geometry::fromVector(model, runs[i].x), {}}});
     }
     // On a subsample, nearby optima can swap ranks (measured on bench-fit):
     // finish the best few distinct ones.
