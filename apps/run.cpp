@@ -157,23 +157,7 @@ class RunCommand : public cli::Command {
     Plan p;
     for (const auto& in : stage.inputs) p.inputs.push_back(in == "CT" ? input_ : output_ / in);
     for (const auto& out : stage.outputs) p.outputs.push_back(output_ / out);
-    const std::string label = (output_ / "label.nii.gz").string(), bone = (output_ / "bone.vtp").string(),
-                      points = (output_ / "points.ply").string(), fits = (output_ / "fits.json").string();
-    if (stage.name == "segment") {
-      p.args = {"-i", input_.string(), "-o", label, "--joint", joint_, "--side", side_};
-    } else if (stage.name == "mesh") {
-      p.args = {"-i", label, "-o", bone, "--ct", input_.string()};
-    } else if (stage.name == "sample") {
-      p.args = {"-i", bone, "-o", points};
-    } else if (stage.name == "fit") {
-      p.args = {"-i", points, "-o", fits};
-    } else if (stage.name == "errors") {
-      p.args = {"-i", points, "--fits", fits, "-o", (output_ / "errors").string()};
-    } else if (stage.name == "report") {
-      p.args = {"-i", output_.string(), "--ct", input_.string(), "--joint", joint_, "--side", side_};
-    } else {
-      throw ProcessingError("run does not know the files of the stage '" + stage.name + "'");
-    }
+    p.args = pipeline::expandArguments(stage, input_.string(), output_.string(), joint_, side_);
     for (const auto& option : stage.options)
       if (auto it = forwarded_.find(option); it != forwarded_.end() && !it->second.empty())
         p.args.insert(p.args.end(), {"--" + option, it->second});

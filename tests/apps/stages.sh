@@ -19,6 +19,13 @@ assert "smoothing" in by["mesh"]["options"], by["mesh"]
 assert by["report"]["options"] == ["selection-tolerance", "selection-floor"], by["report"]
 assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json"]
 assert "CT" in by["mesh"]["inputs"]
+# Every stage's command line reads what it says it reads and writes what it says it writes.
+for s in stages:
+    line = " ".join(s["arguments"])
+    for f in s["inputs"] + s["outputs"]:
+        token = "{CT}" if f == "CT" else "{folder}/" + f.split("/")[0]
+        assert token in line or (s["name"] == "report" and "{folder}" in line), (s["name"], f, line)
+assert by["segment"]["arguments"][:4] == ["-i", "{CT}", "-o", "{folder}/label.nii.gz"], by["segment"]
 help_text = open(sys.argv[2]).read()
 for s in stages:
     for o in s["options"]:

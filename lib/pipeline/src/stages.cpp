@@ -1,5 +1,7 @@
 #include "articula/pipeline/stages.hpp"
 
+#include <utility>
+
 #include "articula/core/error.hpp"
 
 namespace articula::pipeline {
@@ -10,30 +12,39 @@ const std::vector<StageDescription>& stages() {
        "Segment the joint head from a CT (label image)",
        {"seed-point", "series-uid", "hu-min", "hu-max", "roi", "level-set"},
        {"CT"},
-       {"label.nii.gz"}},
+       {"label.nii.gz"},
+       {"-i", "{CT}", "-o", "{folder}/label.nii.gz", "--joint", "{joint}", "--side", "{side}"}},
       // The CT too: the surface moves onto its bone edge (sub-voxel).
       {"mesh",
        "Marching cubes and smoothing of the label, moved onto the CT's bone edge",
        {"series-uid", "smoothing", "smooth-iterations", "relaxation", "decimate"},
        {"label.nii.gz", "CT"},
-       {"bone.vtp"}},
+       {"bone.vtp"},
+       {"-i", "{folder}/label.nii.gz", "-o", "{folder}/bone.vtp", "--ct", "{CT}"}},
       {"sample",
        "Articular surface of the mesh, Gaussian-downsampled to points with normals",
        {"select", "ball-radius", "ratio"},
        {"bone.vtp"},
-       {"points.ply"}},
-      {"fit", "The shape-model hierarchy fitted to the points", {"models", "objective"}, {"points.ply"},
-       {"fits.json", "fits.csv"}},
+       {"points.ply"},
+       {"-i", "{folder}/bone.vtp", "-o", "{folder}/points.ply"}},
+      {"fit",
+       "The shape-model hierarchy fitted to the points",
+       {"models", "objective"},
+       {"points.ply"},
+       {"fits.json", "fits.csv"},
+       {"-i", "{folder}/points.ply", "-o", "{folder}/fits.json"}},
       {"errors",
        "Signed Euclidean errors of every fitted model",
        {},
        {"points.ply", "fits.json"},
-       {"errors/summary.json", "errors/histogram.svg", "errors/error_map.svg"}},
+       {"errors/summary.json", "errors/histogram.svg", "errors/error_map.svg"},
+       {"-i", "{folder}/points.ply", "--fits", "{folder}/fits.json", "-o", "{folder}/errors"}},
       {"report",
        "Results, the selected model and the head's checks from the stage outputs",
        {"selection-tolerance", "selection-floor"},
        {"fits.json", "errors/summary.json", "points.ply"},
-       {"results.json", "results.csv", "head.mrk.json"}},
+       {"results.json", "results.csv", "head.mrk.json"},
+       {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"}},
   };
   return table;
 }
@@ -50,6 +61,29 @@ std::string stageNames() {
   return names;
 }
 
+std::vector<std::string> expandArguments(const StageDescription& stage, const std::string& ct, const std::string& folder,
+                                         const std::string& joint, const std::string& side) {
+  const std::pair<std::string, std::string> fields[] = {{"{CT}", ct}, {"{folder}", folder}, {"{joint}", joint}, {"{side}", side}};
+  std::vector<std::string> out;
+  for (const std::string& argument : stage.arguments) {
+    // One pass: a path that itself holds "{side}" stays as it is.
+    std::string expanded;
+    for (size_t at = 0; at < argument.size();) {
+      bool replaced = false;
+      for (const auto& [key, value] : fields)
+        if (argument.compare(at, key.size(), key) == 0) {
+          expanded += value;
+          at += key.size();
+          replaced = true;
+          break;
+        }
+      if (!replaced) expanded += argument[at++];
+    }
+    out.push_back(expanded);
+  }
+  return out;
+}
+
 nlohmann::json stagesJson() {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& s : stages())
@@ -57,7 +91,8 @@ nlohmann::json stagesJson() {
                     {"description", s.description},
                     {"options", s.options},
                     {"inputs", s.inputs},
-                    {"outputs", s.outputs}});
+                    {"outputs", s.outputs},
+                    {"arguments", s.arguments}});
   return {{"stages", list}};
 }
 

@@ -1,10 +1,11 @@
 #pragma once
 // The pipeline's stages in run order, in one table: what each stage reads
-// and writes in a subject's folder, and which options a user may give for it
-// through `articula run`, a batch manifest column or the Snakemake workflow.
-// `articula run` chains the stages from it, `articula stages --json` prints
-// it, and pipelines/Snakefile builds its per-stage options from that print.
-// Adding a stage: its command in apps/, one row here.
+// and writes in a subject's folder, its command line there, and which
+// options a user may give for it through `articula run`, a batch manifest
+// column or the Snakemake workflow. `articula run` chains the stages from
+// it, `articula stages --json` prints it, and pipelines/Snakefile makes one
+// rule per stage from that print. Adding a stage: its command in apps/, one
+// row here.
 #include <string>
 #include <vector>
 
@@ -18,7 +19,14 @@ struct StageDescription {
   std::vector<std::string> options;  // forwarded options, without "--" (manifest columns use '_' for '-')
   std::vector<std::string> inputs;   // in the subject folder; "CT" is the subject's input
   std::vector<std::string> outputs;  // in the subject folder
+  /// Its command line in a subject's folder, without the standard options:
+  /// {CT} the subject's input, {folder} its folder, {joint} and {side}.
+  std::vector<std::string> arguments;
 };
+
+/// The arguments with {CT}, {folder}, {joint} and {side} replaced.
+std::vector<std::string> expandArguments(const StageDescription& stage, const std::string& ct, const std::string& folder,
+                                         const std::string& joint, const std::string& side);
 
 /// segment, mesh, sample, fit, errors, report.
 const std::vector<StageDescription>& stages();
@@ -29,7 +37,7 @@ const StageDescription& stageNamed(const std::string& name);
 /// The stage names joined by ", " (for help texts).
 std::string stageNames();
 
-/// {"stages": [{"name", "description", "options", "inputs", "outputs"}, ...]}
+/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments"}, ...]}
 nlohmann::json stagesJson();
 
 }  // namespace articula::pipeline
