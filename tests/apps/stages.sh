@@ -17,7 +17,7 @@ by = {s["name"]: s for s in stages}
 assert "series-uid" in by["segment"]["options"] and "series-uid" in by["mesh"]["options"]
 assert "smoothing" in by["mesh"]["options"], by["mesh"]
 assert by["report"]["options"] == ["selection-tolerance", "selection-floor"], by["report"]
-assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json"]
+assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html"]
 assert "CT" in by["mesh"]["inputs"]
 # Every stage's command line names the files it reads and the first it writes
 # (the others go beside it: fits.csv beside fits.json); the report reads its folder.
@@ -51,6 +51,27 @@ r = json.load(open(sys.argv[1]))
 assert r["selected_model"] == sys.argv[2], (r["selected_model"], sys.argv[2])
 assert "articula-report -i " in r["provenance"]["command"], r["provenance"]["command"]
 assert r["qc"]["status"] in ("pass", "warn"), r["qc"]
+PY
+# report.html: self-contained (no script, stylesheet or image from elsewhere),
+# its numbers those of results.json, both error figures inline.
+python3 - "$tmp/r/report.html" "$tmp/r/results.json" <<'PY'
+import json, re, sys
+html, r = open(sys.argv[1]).read(), json.load(open(sys.argv[2]))
+assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
+assert not re.search(r'<(script|link|img|iframe)\b', html), "external or active content"
+assert not re.search(r'(src|href)\s*=\s*"(?!#)', html), "a reference leaves the page"
+assert len(html) < 5e6, len(html)
+selected = r["selected_model"]
+assert re.search(r'id="selected-model">%s<' % selected, html)
+model = next(m for m in r["models"] if m["model"] == selected)
+assert re.search(r'id="rms">%.3f<' % model["errors"]["rms_mm"], html), "RMS differs from results.json"
+for m in r["models"]:
+    assert re.search(r'data-model="%s"><td>%s</td><td>%d</td><td class="rms">%.3f<' % (
+        m["model"], m["model"], m["n_parameters"], m["errors"]["rms_mm"]), html), m["model"]
+assert 'class="status %s"' % r["qc"]["status"] in html
+assert html.count("<svg") >= 2, "the error figures are not inline"
+methods = re.search(r'<p id="methods">(.*?)</p>', html, re.S).group(1)
+assert "The %s was selected" % selected in methods and r["provenance"]["git_commit"] in methods, methods
 PY
 expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force --selection-floor 1
 grep -q '"selected_model": "sphere"' "$tmp/r/results.json" || fail "--selection-floor 1 should select the sphere"

@@ -19,6 +19,7 @@
 #include "articula/core/csv.hpp"
 #include "articula/pipeline/markups.hpp"
 #include "articula/pipeline/statistics.hpp"
+#include "articula/pipeline/subject_html.hpp"
 #include "articula/points/point_io.hpp"
 
 namespace articula::pipeline {
@@ -196,6 +197,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"provenance", provenanceJson(provenance)}};
   writeFileAtomically(o.folder / "results.csv", csvLine(csv_header) + "\n" + csv_rows);
   writeFileAtomically(o.folder / "results.json", results.dump(2) + "\n");
+  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder));
   return qc;
 }
 

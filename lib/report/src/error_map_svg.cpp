@@ -81,7 +81,7 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);
   out << svg::open(W, H) << "<text x=\"" << W / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">"
-      << svg::escape(title) << "</text>\n";
+      << escapeMarkup(title) << "</text>\n";
   {
     std::ostringstream c1, c2;
     c1 << std::setprecision(2) << std::fixed << "Lambert azimuthal equal-area maps of the " << n
@@ -92,8 +92,8 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
     c2 << std::setprecision(1) << std::fixed << "seen from outside the head: right \u2248 " << anatomical(map.right)
        << ", up \u2248 " << anatomical(map.up) << "; map distances in mm on the sphere of radius " << map.radius_mm
        << " mm (LPS); dashed: 90\u00b0 from the axis";
-    out << "<text x=\"" << W / 2 << "\" y=\"46\" text-anchor=\"middle\">" << svg::escape(c1.str()) << "</text>\n"
-        << "<text x=\"" << W / 2 << "\" y=\"63\" text-anchor=\"middle\">" << svg::escape(c2.str()) << "</text>\n";
+    out << "<text x=\"" << W / 2 << "\" y=\"46\" text-anchor=\"middle\">" << escapeMarkup(c1.str()) << "</text>\n"
+        << "<text x=\"" << W / 2 << "\" y=\"63\" text-anchor=\"middle\">" << escapeMarkup(c2.str()) << "</text>\n";
   }
 
   for (size_t k = 0; k < panels.size(); ++k) {
@@ -106,7 +106,7 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
     for (Eigen::Index i = 0; i < n; ++i) sse += panel.d[i] * panel.d[i];
     const bool best = !options.highlight.empty() && panel.label == options.highlight;
     out << "<g class=\"panel\">\n<text x=\"" << x0 + side / 2 << "\" y=\"" << y0 - 10 << "\" text-anchor=\"middle\""
-        << (best ? " font-weight=\"bold\"" : "") << ">" << svg::escape(panel.label) << ": RMS "
+        << (best ? " font-weight=\"bold\"" : "") << ">" << escapeMarkup(panel.label) << ": RMS "
         << svg::label(n ? std::sqrt(sse / static_cast<double>(n)) : 0.0) << " mm" << (best ? " (best)" : "")
         << "</text>\n<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << side << "\" height=\"" << side
         << "\" fill=\"none\" stroke=\"black\"/>\n";

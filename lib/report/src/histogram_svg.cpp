@@ -59,7 +59,7 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
   std::ostringstream out;
   out << std::fixed << std::setprecision(2);
   out << svg::open(W, H) << "<text x=\"" << W / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">"
-      << svg::escape(title) << "</text>\n";
+      << escapeMarkup(title) << "</text>\n";
   // Axes, ticks and labels.
   out << "<line x1=\"" << left << "\" y1=\"" << top + ph << "\" x2=\"" << left + pw << "\" y2=\"" << top + ph
       << "\" stroke=\"black\"/>\n<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\""
@@ -101,7 +101,7 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
     const double ly = top + 10 + 18.0 * static_cast<double>(k);
     out << "<line x1=\"" << left + pw - 320 << "\" y1=\"" << ly << "\" x2=\"" << left + pw - 295 << "\" y2=\"" << ly
         << "\" stroke-width=\"2\" stroke=\"" << svg::seriesColour(k) << "\"/><text x=\"" << left + pw - 290 << "\" y=\"" << ly + 4
-        << "\">" << svg::escape(s.label) << std::setprecision(3) << " (mu " << s.mu << ", sigma " << s.sigma << " mm)"
+        << "\">" << escapeMarkup(s.label) << std::setprecision(3) << " (mu " << s.mu << ", sigma " << s.sigma << " mm)"
         << std::setprecision(2) << "</text>\n";
   }
   out << "</svg>\n";

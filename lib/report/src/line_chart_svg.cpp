@@ -33,7 +33,7 @@ std::string lineChartSvg(const std::vector<LineSeries>& series, const LineChart&
 
   std::ostringstream out;
   out << svg::open(W, H);
-  out << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << svg::escape(chart.title)
+  out << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << escapeMarkup(chart.title)
       << "</text>\n";
   out << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << W - left - right << "\" height=\"" << H - top - bottom
       << "\" fill=\"none\" stroke=\"#444\"/>\n";
@@ -48,12 +48,12 @@ std::string lineChartSvg(const std::vector<LineSeries>& series, const LineChart&
         << "\" stroke=\"#444\"/><text x=\"" << left - 8 << "\" y=\"" << py(t) + 4 << "\" text-anchor=\"end\">"
         << (chart.log_y ? "1e" + svg::label(t) : svg::label(t)) << "</text>\n";
   out << "<text x=\"" << (left + W - right) / 2 << "\" y=\"" << H - 15 << "\" text-anchor=\"middle\">"
-      << svg::escape(chart.x_label) << "</text>\n";
+      << escapeMarkup(chart.x_label) << "</text>\n";
   out << "<text transform=\"translate(18," << (top + H - bottom) / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << svg::escape(chart.y_label) << "</text>\n";
+      << escapeMarkup(chart.y_label) << "</text>\n";
   for (size_t k = 0; k < series.size(); ++k) {
     const LineSeries& s = series[k];
-    out << "<g class=\"series\"><title>" << svg::escape(s.label) << "</title>";
+    out << "<g class=\"series\"><title>" << escapeMarkup(s.label) << "</title>";
     std::ostringstream points;
     bool open = false;
     const auto flush = [&] {
@@ -74,7 +74,7 @@ std::string lineChartSvg(const std::vector<LineSeries>& series, const LineChart&
     flush();
     out << "</g>\n";
     out << "<text x=\"" << left + 10 << "\" y=\"" << top + 16 + 16 * static_cast<double>(k) << "\" fill=\""
-        << svg::seriesColour(k) << "\">" << svg::escape(s.label) << "</text>\n";
+        << svg::seriesColour(k) << "\">" << escapeMarkup(s.label) << "</text>\n";
   }
   out << "</svg>\n";
   return out.str();

@@ -40,7 +40,7 @@ std::string studyRmsSvg(const StudyRms& study, const std::string& title) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);
   out << svg::open(W, H) << "<text x=\"" << W / 2 << "\" y=\"26\" text-anchor=\"middle\" font-size=\"15\">"
-      << svg::escape(title) << "</text>\n";
+      << escapeMarkup(title) << "</text>\n";
   // Axes, grid, ticks and labels.
   out << "<line x1=\"" << left << "\" y1=\"" << top + ph << "\" x2=\"" << left + slot * static_cast<double>(M)
       << "\" y2=\"" << top + ph << "\" stroke=\"black\"/>\n<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\""
@@ -52,7 +52,7 @@ std::string studyRmsSvg(const StudyRms& study, const std::string& title) {
         << "\" text-anchor=\"end\">" << svg::label(t) << "</text>\n";
   for (Eigen::Index m = 0; m < M; ++m)
     out << "<text x=\"" << X(m) << "\" y=\"" << top + ph + 20 << "\" text-anchor=\"middle\">"
-        << svg::escape(study.models[static_cast<size_t>(m)]) << "</text>\n";
+        << escapeMarkup(study.models[static_cast<size_t>(m)]) << "</text>\n";
   out << "<text x=\"" << left + slot * static_cast<double>(M) / 2 << "\" y=\"" << H - 15
       << "\" text-anchor=\"middle\">model (more parameters to the right)</text>\n<text x=\"20\" y=\"" << top + ph / 2
       << "\" text-anchor=\"middle\" transform=\"rotate(-90 20 " << top + ph / 2
@@ -81,12 +81,12 @@ std::string studyRmsSvg(const StudyRms& study, const std::string& title) {
       const double v = study.rms_mm(s, m);
       if (!std::isfinite(v)) continue;
       out << "<circle cx=\"" << X(m) << "\" cy=\"" << Y(v) << "\" r=\"3.5\" stroke=\"#555555\" fill=\""
-          << (m == best ? "#555555" : "white") << "\"><title>" << svg::escape(id) << ' '
-          << svg::escape(study.models[static_cast<size_t>(m)]) << ": " << svg::label(v) << " mm</title></circle>\n";
+          << (m == best ? "#555555" : "white") << "\"><title>" << escapeMarkup(id) << ' '
+          << escapeMarkup(study.models[static_cast<size_t>(m)]) << ": " << svg::label(v) << " mm</title></circle>\n";
     }
     if (last >= 0 && S <= 30)
       out << "<text x=\"" << X(last) + 10 << "\" y=\"" << Y(study.rms_mm(s, last)) + 4
-          << "\" font-size=\"10\" fill=\"#555555\">" << svg::escape(id) << "</text>\n";
+          << "\" font-size=\"10\" fill=\"#555555\">" << escapeMarkup(id) << "</text>\n";
     out << "</g>\n";
   }
   // Per-model means, joined.
@@ -104,7 +104,7 @@ std::string studyRmsSvg(const StudyRms& study, const std::string& title) {
   for (Eigen::Index m = 0; m < M; ++m) {
     const double v = mean[static_cast<size_t>(m)];
     if (!std::isfinite(v)) continue;
-    const std::string name = svg::escape(study.models[static_cast<size_t>(m)]);
+    const std::string name = escapeMarkup(study.models[static_cast<size_t>(m)]);
     out << "<rect class=\"mean\" x=\"" << X(m) - 18 << "\" y=\"" << Y(v) - 2 << "\" width=\"36\" height=\"4\" fill=\"black\"><title>mean "
         << name << ": " << svg::label(v) << " mm (" << count[static_cast<size_t>(m)] << " subjects)</title></rect>\n"
         << "<text x=\"" << X(m) - 22 << "\" y=\"" << Y(v) + 4

@@ -6,6 +6,8 @@
 // gnuplot in a subprocess, and the figures are simple (lines, dots, text).
 #include <string>
 
+#include "articula/report/markup_text.hpp"
+
 namespace articula::report::svg {
 
 /// A "nice" tick step (1, 2 or 5 times a power of ten) giving about `target`
@@ -18,8 +20,6 @@ const char* seriesColour(size_t i);
 /// `v` as a short label: up to 3 significant digits, "0" for |v| < 1e-12.
 std::string label(double v);
 
-/// `text` with &, <, > and " escaped for XML character data and attributes.
-std::string escape(const std::string& text);
 
 /// The opening <svg> element (sans-serif, 12 px) and a white background.
 std::string open(double width, double height);

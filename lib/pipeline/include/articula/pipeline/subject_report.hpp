@@ -2,8 +2,9 @@
 // A subject's results from its stage outputs: results.json (every model's
 // parameters with units, standard errors, errors, AIC/BIC, the selected
 // model, the head's QC checks, provenance), results.csv (a row per model)
-// and head.mrk.json (the head centre and axes for 3D Slicer), all in the
-// subject's folder. The report stage of the pipeline.
+// head.mrk.json (the head centre and axes for 3D Slicer) and report.html
+// (subject_html.hpp: the page a reader checks), all in the subject's folder.
+// The report stage of the pipeline.
 #include <filesystem>
 #include <string>
 
@@ -28,7 +29,7 @@ struct SubjectReportOptions {
   long long seed = -1;           // recorded in the provenance
 };
 
-/// Writes results.json, results.csv and head.mrk.json into options.folder and
+/// Writes results.json, results.csv, head.mrk.json and report.html into options.folder and
 /// returns the head's QC report (the caller decides what a failure means).
 /// Throws InputError when a stage output is missing or unreadable.
 QcReport writeSubjectReport(const SubjectReportOptions& options);

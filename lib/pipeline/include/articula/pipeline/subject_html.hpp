@@ -1,0 +1,22 @@
+#pragma once
+// report.html: a subject's results as one self-contained page that opens
+// offline (no external resource, no script): the verdict first (the head's
+// checks and their reasons, the selected model, the head centre and radii
+// with 95 % intervals), the checks, the five models, the error figures of
+// the errors stage inline, and an About section (version, commit, command,
+// date, parameters, input hashes and a methods paragraph generated from the
+// run, to paste into a paper). Written by the report stage beside
+// results.json, from it and the stage outputs of the subject's folder.
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace articula::pipeline {
+
+/// The page for `results` (results.json's document) of the subject in
+/// `folder` (its errors/*.svg inlined; points.ply.json, label.nii.gz.json
+/// and bone.vtp.json read for the methods, when present).
+std::string subjectReportHtml(const nlohmann::json& results, const std::filesystem::path& folder);
+
+}  // namespace articula::pipeline
