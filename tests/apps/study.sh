@@ -69,6 +69,21 @@ assert set(means) == models, means
 for m, (v, n) in means.items():
     assert abs(v - float(summary[m]["rms_mean_mm"])) <= 0.005 * float(summary[m]["rms_mean_mm"]), (m, v, summary[m])
     assert n == 2
+# study.html: the failed subjects with their reasons, every link resolving
+# inside the study folder, a dot per subject linking to its report.html.
+import os
+html = open(f"{study}/study.html").read()
+assert not re.search(r"<(script|link|img|iframe)\b", html), "external or active content"
+links = re.findall(r'href="([^"]*)"', html)
+for link in links:
+    assert not re.match(r"[a-z]+:", link) and os.path.exists(os.path.join(study, link)), link
+for s in ("missing", "baddicom"):
+    row = re.search(r'<tr class="failed"><td>.*?%s.*?</tr>' % s, html)
+    assert row and status[s]["message"][:40].replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;").replace("'", "&#39;") in row.group(0), s
+assert re.search(r'<span id="failed">2</span>', html)
+for s in ("p1", "p2"):
+    assert html.count('href="subjects/%s/report.html"' % s) >= 5, s  # one dot per RMS plot at least
+    assert os.path.exists(f"{study}/subjects/{s}/report.html")
 PY
 
 # A rerun resumes: nothing is redone, and it is fast.

@@ -12,6 +12,7 @@
 #include "articula/core/log.hpp"
 #include "articula/core/csv.hpp"
 #include "articula/pipeline/statistics.hpp"
+#include "articula/pipeline/study_html.hpp"
 #include "articula/report/study_svg.hpp"
 
 namespace articula::pipeline {
@@ -68,10 +69,12 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   std::vector<ModelRow> rows;
   std::vector<std::string> parameter_columns;  // union, in order of first appearance
   std::vector<std::string> model_order;
+  std::vector<std::pair<std::string, nlohmann::json>> finished;  // results.json of each finished subject
   for (size_t i = 0; i < subjects.size(); ++i) {
     if (batch.outcomes[i].status != "ok") continue;
     const fs::path path = subjectDir(study_dir, subjects[i].id) / "results.json";
-    const nlohmann::json results = readJsonFile(path, "study (" + subjects[i].id + ")");
+    const nlohmann::json& results =
+        finished.emplace_back(subjects[i].id, readJsonFile(path, "study (" + subjects[i].id + ")")).second;
     const std::string best = results.value("best_model", ""), selected = results.value("selected_model", "");
     std::string qc_status, qc_reasons;
     if (results.contains("qc") && results.at("qc").is_object()) {
@@ -203,6 +206,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   writeFileAtomically(study_dir / "study_status.csv", status_csv);
   writeFileAtomically(study_dir / "study.json", study.dump(2) + "\n");
   if (!rows.empty()) writeFileAtomically(study_dir / "study.svg", studyFigure(rows, model_order, study_dir));
+  writeFileAtomically(study_dir / "study.html", studyReportHtml(study, finished, study_dir));
   return study;
 }
 

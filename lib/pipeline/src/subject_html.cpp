@@ -9,46 +9,23 @@
 
 #include "articula/core/json_file.hpp"
 #include "articula/report/markup_text.hpp"
+#include "results_json.hpp"
 
 namespace articula::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using detail::member;
+using detail::modelNamed;
+using detail::numberAt;
+using detail::text;
 
 std::string fixed(double v, int digits) {
   if (!std::isfinite(v)) return "-";
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", digits, v);
   return buffer;
-}
-
-// A member of a JSON object by reference (null when absent): the pages
-// iterate over members, and nlohmann's value() returns copies whose items()
-// would dangle in a range-for.
-const json& member(const json& object, const std::string& key) {
-  static const json kAbsent;
-  if (!object.is_object()) return kAbsent;
-  const auto it = object.find(key);
-  return it == object.end() ? kAbsent : *it;
-}
-
-// A number of a JSON object, or NaN.
-double numberAt(const json& object, const std::string& key) {
-  const auto it = object.find(key);
-  return it != object.end() && it->is_number() ? it->get<double>() : NAN;
-}
-
-std::string text(const json& object, const std::string& key) {
-  const auto it = object.find(key);
-  if (it == object.end() || it->is_null()) return "";
-  return it->is_string() ? it->get<std::string>() : it->dump();
-}
-
-const json* modelNamed(const json& results, const std::string& name) {
-  for (const auto& m : member(results, "models"))
-    if (m.value("model", "") == name) return &m;
-  return nullptr;
 }
 
 // "22.72 ± 0.19" (the 95 % interval's half width) or the value alone.

@@ -1,0 +1,125 @@
+#include "articula/pipeline/study_html.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "articula/report/markup_text.hpp"
+#include "results_json.hpp"
+#include "articula/report/strip_plot_svg.hpp"
+
+namespace articula::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using detail::member;
+using detail::modelNamed;
+using detail::numberAt;
+using detail::text;
+using report::escapeMarkup;
+
+// The subject's page if the study holds it, else its log; relative to the study folder.
+std::string subjectLink(const fs::path& study_dir, const std::string& id) {
+  for (const char* file : {"report.html", "run.log"})
+    if (fs::exists(study_dir / "subjects" / id / file)) return "subjects/" + id + "/" + file;
+  return "";
+}
+
+std::string linked(const std::string& label, const std::string& link) {
+  return link.empty() ? escapeMarkup(label) : "<a href=\"" + escapeMarkup(link) + "\">" + escapeMarkup(label) + "</a>";
+}
+
+struct Quantity {
+  std::string title, unit, model, parameter;  // model "" : the subject's selected model
+};
+
+std::string plots(const std::vector<std::pair<std::string, json>>& results, const fs::path& study_dir,
+                  const std::vector<std::string>& models) {
+  std::vector<Quantity> quantities;
+  for (const auto& model : models) quantities.push_back({"RMS of the " + model, "mm", model, "rms_mm"});
+  for (const char* axis : {"a", "b", "c"})
+    quantities.push_back({std::string("Radius ") + axis + " of the selected model", "mm", "", std::string(axis) + "_mm"});
+  for (const char* exponent : {"gamma1", "gamma2", "gamma3"})
+    quantities.push_back({std::string("Superellipsoid exponent ") + exponent, "", "superellipsoid", exponent});
+  std::string html;
+  for (const Quantity& q : quantities) {
+    std::vector<report::StripPoint> points;
+    for (const auto& [id, r] : results) {
+      const json* m = modelNamed(r, q.model.empty() ? text(r, "selected_model") : q.model);
+      const double v = !m ? NAN : q.parameter == "rms_mm" ? numberAt(member(*m, "errors"), "rms_mm")
+                                                          : numberAt(member(*m, "parameters"), q.parameter);
+      points.push_back({id, v, subjectLink(study_dir, id)});
+    }
+    html += "<figure>" + report::stripPlotSvg(q.title, q.unit, points) + "</figure>\n";
+  }
+  return html;
+}
+
+std::string selectedModels(const std::vector<std::pair<std::string, json>>& results, const fs::path& study_dir,
+                           const std::vector<std::string>& models) {
+  std::string html = "<table><tr><th>selected model</th><th>subjects</th><th>count</th></tr>\n";
+  for (const auto& model : models) {
+    std::string subjects;
+    int count = 0;
+    for (const auto& [id, r] : results)
+      if (text(r, "selected_model") == model) subjects += (count++ ? ", " : "") + linked(id, subjectLink(study_dir, id));
+    html += "<tr><td>" + escapeMarkup(model) + "</td><td>" + subjects + "</td><td>" + std::to_string(count) + "</td></tr>\n";
+  }
+  return html + "</table>\n";
+}
+
+constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color:#222}
+table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left}
+th{background:#f4f4f4}tr.failed td{background:#fde7e9}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}
+figure{margin:.5em 0}figure svg{max-width:100%;height:auto}.note{color:#666;font-size:.9em})";
+
+}  // namespace
+
+std::string studyReportHtml(const json& study, const std::vector<std::pair<std::string, json>>& results,
+                            const fs::path& study_dir) {
+  std::vector<std::string> models;
+  for (const auto& m : member(study, "models")) models.push_back(text(m, "model"));
+  const json& subjects = member(study, "subjects");
+  int flagged = 0;
+  std::string look = "<table><tr><th>subject</th><th>status</th><th>reason</th></tr>\n";
+  for (const auto& s : subjects) {
+    const std::string id = text(s, "subject");
+    if (text(s, "status") != "ok") {
+      look += "<tr class=\"failed\"><td>" + linked(id, subjectLink(study_dir, id)) + "</td><td>failed (exit " +
+              text(s, "exit_code") + ")</td><td>" + escapeMarkup(text(s, "message")) + "</td></tr>\n";
+      continue;
+    }
+    for (const auto& [rid, r] : results) {
+      const std::string status = text(member(r, "qc"), "status");
+      if (rid != id || status == "pass") continue;
+      ++flagged;
+      std::string reasons;
+      for (const auto& reason : member(member(r, "qc"), "reasons"))
+        reasons += (reasons.empty() ? "" : "; ") + (reason.is_string() ? reason.get<std::string>() : reason.dump());
+      look += "<tr class=\"" + escapeMarkup(status) + "\"><td>" + linked(id, subjectLink(study_dir, id)) + "</td><td>checks: " +
+              escapeMarkup(status) + "</td><td>" + escapeMarkup(reasons) + "</td></tr>\n";
+    }
+  }
+  look += "</table>\n";
+  const json& provenance = member(study, "provenance");
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>articula study</title>\n<style>"
+       << kStyle << "</style></head>\n<body>\n<h1>articula study</h1>\n<p id=\"counts\">" << subjects.size()
+       << " subjects: <span id=\"succeeded\">" << numberAt(study, "succeeded") << "</span> finished, <span id=\"failed\">"
+       << numberAt(study, "failed") << "</span> failed, <span id=\"flagged\">" << flagged
+       << "</span> flagged by their checks.</p>\n<section id=\"look\"><h2>Subjects to look at</h2>\n" << look
+       << "</section>\n<section id=\"quantities\"><h2>Across the subjects</h2>\n<p class=\"note\">A dot per subject; a "
+          "click opens its page.</p>\n"
+       << plots(results, study_dir, models) << "<h3>Selected models</h3>\n" << selectedModels(results, study_dir, models)
+       << "</section>\n<section id=\"tables\"><h2>Tables</h2><ul>";
+  for (const char* file : {"study.csv", "study_summary.csv", "study_status.csv", "study.json", "study.svg"})
+    if (fs::exists(study_dir / file)) html << "<li><a href=\"" << file << "\">" << file << "</a></li>";
+  html << "</ul></section>\n<section id=\"about\"><h2>About</h2><table><tr><th>articula</th><td>"
+       << escapeMarkup(text(provenance, "articula_version")) << " (commit " << escapeMarkup(text(provenance, "git_commit"))
+       << ")</td></tr><tr><th>command</th><td><code>" << escapeMarkup(text(provenance, "command"))
+       << "</code></td></tr></table></section>\n</body></html>\n";
+  return html.str();
+}
+
+}  // namespace articula::pipeline
