@@ -34,6 +34,9 @@ rc=$?
 set -e
 first=$(python3 -c "print(round($(date +%s.%N) - $start, 2))")
 [ "$rc" -eq 1 ] || { cat "$tmp/batch.err" >&2; fail "batch with failing subjects exited $rc, expected 1"; }
+# Progress: a line per subject with what is done, failed and left.
+grep -q "\[4 of 4 done, 2 failed, 0 remaining\]" "$tmp/batch.err" || { cat "$tmp/batch.err" >&2; fail "no final progress line"; }
+grep -q "of 4 done, .* remaining, about [0-9]* s left\]" "$tmp/batch.err" || fail "no time estimate in the progress lines"
 python3 - "$tmp/study" <<'PY'
 import csv, json, sys
 study = sys.argv[1]

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cerrno>
 #include <cstring>
 #include <chrono>
@@ -87,6 +88,27 @@ BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& 
   summary.outcomes.resize(subjects.size());
   std::atomic<size_t> next{0};
   std::mutex log_mutex;
+  // Progress on stderr, a line per subject: done, failed, remaining, and the
+  // time left from the subjects run so far (resumed ones took no time).
+  int done = 0, failed = 0, timed = 0;
+  double busy_seconds = 0;
+  const int n_workers = std::min<int>(options.jobs, static_cast<int>(std::max<size_t>(subjects.size(), 1)));
+  const auto progress = [&](const SubjectOutcome& out) {
+    std::lock_guard<std::mutex> lock(log_mutex);
+    ++done;
+    failed += out.status != "ok";
+    if (!out.resumed) busy_seconds += out.seconds, ++timed;
+    if (options.quiet || out.resumed) return;
+    const int remaining = static_cast<int>(subjects.size()) - done;
+    std::string line = "subject " + out.id + ": " + out.status +
+                       (out.status == "ok" ? "" : " (exit " + std::to_string(out.exit_code) + "): " + out.message) + " [" +
+                       std::to_string(done) + " of " + std::to_string(subjects.size()) + " done, " +
+                       std::to_string(failed) + " failed, " + std::to_string(remaining) + " remaining";
+    if (remaining > 0 && timed > 0)
+      line += ", about " + std::to_string(static_cast<long long>(std::ceil(busy_seconds / timed * remaining / n_workers))) +
+              " s left";
+    log::info(line + "]");
+  };
 
   auto work = [&] {
     for (size_t i = next++; i < subjects.size(); i = next++) {
@@ -97,6 +119,7 @@ BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& 
       if (!options.rerun_finished && finishedEarlier(dir)) {
         out.status = "ok";
         out.resumed = true;
+        progress(out);
         continue;
       }
       fs::create_directories(dir);
@@ -119,15 +142,10 @@ BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& 
                                      {"seconds", out.seconds},  {"command", command},
                                      {"input", s.input.string()}};
       writeFileAtomically(dir / "status.json", status.dump(2) + "\n");
-      if (!options.quiet) {
-        std::lock_guard<std::mutex> lock(log_mutex);
-        log::info("subject " + s.id + ": " + out.status +
-                  (out.status == "ok" ? "" : " (exit " + std::to_string(out.exit_code) + "): " + out.message));
-      }
+      progress(out);
     }
   };
   std::vector<std::thread> workers;
-  const int n_workers = std::min<int>(options.jobs, static_cast<int>(std::max<size_t>(subjects.size(), 1)));
   for (int w = 0; w < n_workers; ++w) workers.emplace_back(work);
   for (auto& t : workers) t.join();
 
