@@ -59,7 +59,18 @@ import json, re, sys
 html, r = open(sys.argv[1]).read(), json.load(open(sys.argv[2]))
 assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
 assert not re.search(r'<(script|link|img|iframe)\b', html), "external or active content"
-assert not re.search(r'(src|href)\s*=\s*"(?!#)', html), "a reference leaves the page"
+assert not re.search(r'(src|href)\s*=\s*"(?!#|data:image/png;base64,)', html), "a reference leaves the page"
+# Three CT slices through the head, each an embedded PNG with the label's edge and the model's outline.
+import base64, struct
+slices = re.findall(r'<svg[^>]*class="slice" data-plane="(\w+)".*?href="data:image/png;base64,([^"]+)".*?'
+                    r'class="label-edge" d="([^"]*)".*?class="model-outline" d="([^"]*)"', html, re.S)
+assert [s[0] for s in slices] == ["axial", "coronal", "sagittal"], [s[0] for s in slices]
+for plane, png, edge, outline in slices:
+    png = base64.b64decode(png)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR", plane
+    width, height = struct.unpack(">II", png[16:24])
+    assert width == height and 32 <= width <= 1024, (plane, width, height)
+    assert edge.count("M") > 20 and outline.count("M") > 20, (plane, edge[:80], outline[:80])
 assert len(html) < 5e6, len(html)
 selected = r["selected_model"]
 assert re.search(r'id="selected-model">%s<' % selected, html)

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include "articula/core/error.hpp"
 #include "articula/report/azimuthal_map.hpp"
@@ -17,6 +18,7 @@
 #include "articula/report/line_chart_svg.hpp"
 #include "articula/report/histogram_svg.hpp"
 #include "articula/report/ply_writers.hpp"
+#include "articula/report/slice_image.hpp"
 #include "articula/report/study_svg.hpp"
 
 namespace {
@@ -268,3 +270,48 @@ TEST(LineChart, PointsFollowTheAxesAndNaNBreaksTheLine) {
 }
 
 }  // namespace
+
+// The report's slice images: the PNG's rows come back from its deflate
+// stream byte for byte, base64 matches RFC 4648's examples, and the contour
+// of a sampled circle lies on the circle.
+TEST(SliceImage, PngBase64AndContours) {
+  const int w = 7, h = 5;
+  std::vector<std::uint8_t> pixels(w * h);
+  for (int i = 0; i < w * h; ++i) pixels[static_cast<size_t>(i)] = static_cast<std::uint8_t>(37 * i);
+  const std::string png = articula::report::greyPng(pixels, w, h);
+  ASSERT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const auto u32 = [&](size_t at) {
+    return static_cast<uint32_t>(static_cast<unsigned char>(png[at])) << 24 |
+           static_cast<uint32_t>(static_cast<unsigned char>(png[at + 1])) << 16 |
+           static_cast<uint32_t>(static_cast<unsigned char>(png[at + 2])) << 8 | static_cast<unsigned char>(png[at + 3]);
+  };
+  EXPECT_EQ(png.substr(12, 4), "IHDR");
+  EXPECT_EQ(u32(16), static_cast<uint32_t>(w));
+  EXPECT_EQ(u32(20), static_cast<uint32_t>(h));
+  const size_t idat = png.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  std::string raw(static_cast<size_t>((w + 1) * h), '\0');
+  uLongf raw_size = static_cast<uLongf>(raw.size());
+  ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &raw_size,
+                       reinterpret_cast<const Bytef*>(png.data() + idat + 4), u32(idat - 4)),
+            Z_OK);
+  for (int r = 0; r < h; ++r) {
+    EXPECT_EQ(raw[static_cast<size_t>(r * (w + 1))], '\0');  // filter type none
+    for (int c = 0; c < w; ++c)
+      EXPECT_EQ(static_cast<std::uint8_t>(raw[static_cast<size_t>(r * (w + 1) + 1 + c)]), pixels[static_cast<size_t>(r * w + c)]);
+  }
+  EXPECT_EQ(articula::report::base64("Man"), "TWFu");
+  EXPECT_EQ(articula::report::base64("Ma"), "TWE=");
+  EXPECT_EQ(articula::report::base64("M"), "TQ==");
+  EXPECT_EQ(articula::report::base64("foobar"), "Zm9vYmFy");
+
+  const int n = 41;
+  const double radius = 12.3;
+  Eigen::MatrixXd field(n, n);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) field(r, c) = std::hypot(c - 20.0, r - 20.0) - radius;
+  const auto segments = articula::report::contourSegments(field, 0.0);
+  EXPECT_GT(segments.size(), 60u);
+  for (const auto& s : segments)
+    for (const Eigen::Vector2d& p : {s.a, s.b}) EXPECT_NEAR((p - Eigen::Vector2d(20, 20)).norm(), radius, 0.05);
+}

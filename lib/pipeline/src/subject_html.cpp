@@ -183,16 +183,20 @@ constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1000px;m
 table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left}
 th{background:#f4f4f4}.status{font-size:1.3em}.status.pass{color:#176f2c}.status.warn{color:#a15c00}
 .status.fail{color:#b00020}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}figure{margin:1em 0}
-figure svg{max-width:100%;height:auto}.note{color:#666;font-size:.9em}code{font-size:.9em})";
+figure svg{max-width:100%;height:auto}.slices{display:flex;flex-wrap:wrap;gap:.5em}
+.slices figure{margin:0}.note{color:#666;font-size:.9em}code{font-size:.9em})";
 
 }  // namespace
 
-std::string subjectReportHtml(const json& results, const fs::path& folder) {
+std::string subjectReportHtml(const json& results, const fs::path& folder, const std::string& slices_html) {
   const std::string title = "articula: " + results.value("side", "") + " " + results.value("joint", "") + " head";
   std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" + report::escapeMarkup(title) +
                      "</title>\n<style>" + kStyle + "</style></head>\n<body>\n<h1>" + report::escapeMarkup(title) + "</h1>\n<p>" +
                      report::escapeMarkup(results.value("input", "")) + "</p>\n";
   html += verdictSection(results);
+  html += "<section id=\"slices\"><h2>CT through the head</h2>\n<p class=\"note\">The selected model's outline in "
+          "magenta, the segmentation's edge in yellow; radiological view (the patient's left on the right).</p>\n" +
+          slices_html + "</section>\n";
   html += checksSection(results);
   html += modelsSection(results);
   html += "<section id=\"errors\"><h2>Signed distances of the points to each model</h2>\n" +

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <optional>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -18,9 +20,12 @@
 #include "articula/geometry/shape.hpp"
 #include "articula/core/csv.hpp"
 #include "articula/pipeline/markups.hpp"
+#include "articula/imaging/io.hpp"
+#include "articula/pipeline/head_slices.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
 #include "articula/points/point_io.hpp"
+#include "articula/report/markup_text.hpp"
 
 namespace articula::pipeline {
 namespace {
@@ -73,6 +78,26 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
     }
   }
   return checkHead(in);
+}
+
+// The report's CT slices through the selected model, or a note why there
+// are none (no CT given, one that cannot be read without options the report
+// does not take, a model that cannot be drawn): they show, they decide nothing.
+std::string slicesThroughHead(const SubjectReportOptions& o, const json& results) {
+  try {
+    if (o.ct.empty()) return "<p class=\"note\">No CT given (--ct).</p>";
+    geometry::ShapeParameters model;
+    const std::string selected = results.value("selected_model", "");
+    for (const auto& shape : fit::shapesFromFitsJson(readStageJson(o.folder / "fits.json"), "fits.json"))
+      if (geometry::modelName(shape.model) == selected) model = shape;
+    const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, {});
+    std::optional<imaging::Label> label;
+    if (fs::exists(o.folder / "label.nii.gz")) label = imaging::readLabel(o.folder / "label.nii.gz");
+    return headSlicesHtml(*ct, label ? &*label : nullptr, model, 1.6 * model.radii.maxCoeff(),
+                          std::min(0.5, ct->geometry.spacing.minCoeff()));
+  } catch (const Error& e) {
+    return "<p class=\"note\">No CT slices: " + report::escapeMarkup(e.what()) + "</p>";
+  }
 }
 
 }  // namespace
@@ -197,7 +222,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"provenance", provenanceJson(provenance)}};
   writeFileAtomically(o.folder / "results.csv", csvLine(csv_header) + "\n" + csv_rows);
   writeFileAtomically(o.folder / "results.json", results.dump(2) + "\n");
-  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder));
+  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder, slicesThroughHead(o, results)));
   return qc;
 }
 

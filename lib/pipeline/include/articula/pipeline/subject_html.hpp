@@ -2,8 +2,9 @@
 // report.html: a subject's results as one self-contained page that opens
 // offline (no external resource, no script): the verdict first (the head's
 // checks and their reasons, the selected model, the head centre and radii
-// with 95 % intervals), the checks, the five models, the error figures of
-// the errors stage inline, and an About section (version, commit, command,
+// with 95 % intervals), CT slices through the head with the segmentation's
+// edge and the model's outline (head_slices.hpp), the checks, the five
+// models, the error figures of the errors stage inline, and an About section (version, commit, command,
 // date, parameters, input hashes and a methods paragraph generated from the
 // run, to paste into a paper). Written by the report stage beside
 // results.json, from it and the stage outputs of the subject's folder.
@@ -16,7 +17,9 @@ namespace articula::pipeline {
 
 /// The page for `results` (results.json's document) of the subject in
 /// `folder` (its errors/*.svg inlined; points.ply.json, label.nii.gz.json
-/// and bone.vtp.json read for the methods, when present).
-std::string subjectReportHtml(const nlohmann::json& results, const std::filesystem::path& folder);
+/// and bone.vtp.json read for the methods, when present), with the CT
+/// slices' figures (or a note why there are none) as given.
+std::string subjectReportHtml(const nlohmann::json& results, const std::filesystem::path& folder,
+                              const std::string& slices_html);
 
 }  // namespace articula::pipeline
