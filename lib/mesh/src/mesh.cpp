@@ -9,31 +9,26 @@
 #include <vtkImageData.h>
 #include <vtkMatrix3x3.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
-#include <vtkPLYReader.h>
 #include <vtkPLYWriter.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataConnectivityFilter.h>
 #include <vtkPolyDataNormals.h>
-#include <vtkPolyDataReader.h>
 #include <vtkQuadricDecimation.h>
-#include <vtkSTLReader.h>
 #include <vtkSTLWriter.h>
 #include <vtkSmartPointer.h>
 #include <vtkSmoothPolyDataFilter.h>
 #include <vtkStringArray.h>
 #include <vtkFieldData.h>
-#include <vtkTriangleFilter.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowedSincPolyDataFilter.h>
-#include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/imaging/edges.hpp"
+#include "articula/points/mesh_file.hpp"
 
 namespace articula::mesh {
 namespace fs = std::filesystem;
@@ -331,29 +326,16 @@ void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
 }
 
 TriangleMesh readMesh(const fs::path& path) {
-  if (!fs::is_regular_file(path)) throw InputError("mesh not found: " + path.string());
-  const std::string ext = extensionOf(path);
-  vtkSmartPointer<vtkPolyData> poly;
-  auto read = [&](auto reader) {
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    poly = reader->GetOutput();
-  };
-  if (ext == ".vtp") read(vtkSmartPointer<vtkXMLPolyDataReader>::New());
-  else if (ext == ".stl") read(vtkSmartPointer<vtkSTLReader>::New());
-  else if (ext == ".ply") read(vtkSmartPointer<vtkPLYReader>::New());
-  else if (ext == ".vtk") read(vtkSmartPointer<vtkPolyDataReader>::New());
-  else if (ext == ".obj") read(vtkSmartPointer<vtkOBJReader>::New());
-  else throw InputError("expected a mesh (.vtp, .stl, .ply, .vtk, .obj), found " + path.string());
-  if (!poly || poly->GetNumberOfPolys() == 0)
-    throw InputError("expected a triangle mesh in " + path.string() + ", found no triangles" +
-                     (poly ? " (" + std::to_string(poly->GetNumberOfPoints()) + " points)" : ""));
-  vtkNew<vtkTriangleFilter> triangles;
-  triangles->SetInputData(poly);
-  triangles->Update();
-  poly = triangles->GetOutput();
-  if (!poly->GetPointData()->GetNormals()) poly = withNormals(poly);
-  return fromVtk(poly);
+  points::MeshFile file = points::readMeshFile(path);
+  if (file.triangles.rows() == 0)
+    throw InputError("expected a triangle mesh in " + path.string() + ", found no triangles (" +
+                     std::to_string(file.vertices.rows()) + " points)");
+  TriangleMesh mesh;
+  mesh.vertices = std::move(file.vertices);
+  mesh.triangles = std::move(file.triangles);
+  mesh.normals = file.normals.rows() == mesh.vertices.rows() ? std::move(file.normals)
+                                                             : fromVtk(withNormals(toVtk(mesh))).normals;
+  return mesh;
 }
 
 }  // namespace articula::mesh

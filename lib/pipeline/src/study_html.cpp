@@ -5,18 +5,15 @@
 #include <sstream>
 
 #include "articula/report/markup_text.hpp"
-#include "results_json.hpp"
 #include "articula/report/strip_plot_svg.hpp"
+#include "results_json.hpp"
 
 namespace articula::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using detail::member;
-using detail::modelNamed;
-using detail::numberAt;
-using detail::text;
+using namespace detail;  // the results.json readers
 using report::escapeMarkup;
 
 // The subject's page if the study holds it, else its log; relative to the study folder.

@@ -16,10 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using detail::member;
-using detail::modelNamed;
-using detail::numberAt;
-using detail::text;
+using namespace detail;  // the results.json readers
 
 std::string fixed(double v, int digits) {
   if (!std::isfinite(v)) return "-";

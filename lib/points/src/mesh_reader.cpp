@@ -1,4 +1,4 @@
-// Vertices of .stl, .obj and .vtp meshes through VTK's readers. VTK reports problems through
+// Meshes (.stl, .obj, .vtp, .vtk, .ply) through VTK's readers. VTK reports problems through
 // error events rather than exceptions, so an observer on the reader, its executive and (for XML)
 // its parser collects them, keeps them off stderr, and we throw InputError with the first one.
 #include <vtkAlgorithm.h>
@@ -7,6 +7,10 @@
 #include <vtkExecutive.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
+#include <vtkPLYReader.h>
+#include <vtkPolyDataReader.h>
+#include <vtkTriangleFilter.h>
+#include <vtkCellArray.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -23,6 +27,7 @@
 #include <vector>
 
 #include "articula/core/error.hpp"
+#include "articula/points/mesh_file.hpp"
 #include "readers.hpp"
 
 namespace articula::points::detail {
@@ -180,6 +185,19 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
     reader->SetFileName(path.c_str());
     return reader;
   }
+  if (ext == ".vtk") {
+    auto reader = vtkSmartPointer<vtkPolyDataReader>::New();
+    reader->SetFileName(path.c_str());
+    return reader;
+  }
+  if (ext == ".ply") {  // a mesh's faces (point files go through ply_reader.cpp)
+    auto reader = vtkSmartPointer<vtkPLYReader>::New();
+    reader->SetFileName(path.c_str());
+    return reader;
+  }
+  if (ext != ".vtp")
+    throw InputError("mesh file " + quoted(path) + ": expected extension .vtp, .stl, .ply, .vtk or .obj, found '" +
+                     path.extension().string() + "'");
   auto reader = vtkSmartPointer<vtkXMLPolyDataReader>::New();
   reader->SetFileName(path.c_str());
   reader->SetParserErrorObserver(errors);  // the XML parser's message names the line and column
@@ -189,8 +207,22 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
 }  // namespace
 
 PointCloud readMeshVertices(const std::filesystem::path& path) {
-  vtkNew<ErrorCollector> errors;
-  vtkSmartPointer<vtkAlgorithm> reader = makeReader(path, errors);
+  MeshFile mesh = readMeshFile(path);
+  PointCloud cloud{std::move(mesh.vertices), std::move(mesh.normals)};
+  finishCloud(cloud, path, [](Eigen::Index i) { return "vertex " + std::to_string(i) + " (0-based)"; });
+  return cloud;
+}
+
+}  // namespace articula::points::detail
+
+namespace articula::points {
+
+MeshFile readMeshFile(const std::filesystem::path& path) {
+  using detail::quoted;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file " + quoted(path) + " not found");
+  vtkNew<detail::ErrorCollector> errors;
+  vtkSmartPointer<vtkAlgorithm> reader = detail::makeReader(path, errors);
   for (vtkObject* source : {static_cast<vtkObject*>(reader), static_cast<vtkObject*>(reader->GetExecutive())}) {
     source->AddObserver(vtkCommand::ErrorEvent, errors);
     source->AddObserver(vtkCommand::WarningEvent, errors);  // silences warnings; Execute keeps errors only
@@ -198,31 +230,44 @@ PointCloud readMeshVertices(const std::filesystem::path& path) {
   reader->Update();
   if (!errors->message.empty())
     throw InputError("mesh file " + quoted(path) + ": VTK could not read it: " + errors->message);
-
-  vtkPolyData* mesh = vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0));
-  vtkPoints* points = mesh ? mesh->GetPoints() : nullptr;
+  vtkPolyData* poly = vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0));
+  vtkPoints* points = poly ? poly->GetPoints() : nullptr;
   if (points == nullptr || points->GetNumberOfPoints() == 0)
     throw InputError("mesh file " + quoted(path) + ": expected vertices, found none");
 
-  PointCloud cloud;
+  MeshFile out;
   const vtkIdType n = points->GetNumberOfPoints();
-  cloud.positions.resize(n, 3);
+  out.vertices.resize(n, 3);
   for (vtkIdType i = 0; i < n; ++i) {
     double p[3];
     points->GetPoint(i, p);
-    cloud.positions.row(i) << p[0], p[1], p[2];
+    out.vertices.row(i) << p[0], p[1], p[2];
   }
-  vtkDataArray* normals = mesh->GetPointData()->GetNormals();
+  vtkDataArray* normals = poly->GetPointData()->GetNormals();
   if (normals != nullptr && normals->GetNumberOfComponents() == 3 && normals->GetNumberOfTuples() == n) {
-    cloud.normals.resize(n, 3);
+    out.normals.resize(n, 3);
     for (vtkIdType i = 0; i < n; ++i) {
       double v[3];
       normals->GetTuple(i, v);
-      cloud.normals.row(i) << v[0], v[1], v[2];
+      out.normals.row(i) << v[0], v[1], v[2];
     }
   }
-  finishCloud(cloud, path, [](Eigen::Index i) { return "vertex " + std::to_string(i) + " (0-based)"; });
-  return cloud;
+  if (poly->GetNumberOfPolys() > 0) {
+    // Polygons as triangles; the filter keeps the points (and their order).
+    vtkNew<vtkTriangleFilter> triangulate;
+    triangulate->SetInputData(poly);
+    triangulate->PassLinesOff();
+    triangulate->PassVertsOff();
+    triangulate->Update();
+    vtkCellArray* cells = triangulate->GetOutput()->GetPolys();
+    out.triangles.resize(cells->GetNumberOfCells(), 3);
+    vtkIdType row = 0, count = 0;
+    const vtkIdType* ids = nullptr;
+    for (cells->InitTraversal(); cells->GetNextCell(count, ids);)
+      if (count == 3) out.triangles.row(row++) << static_cast<int>(ids[0]), static_cast<int>(ids[1]), static_cast<int>(ids[2]);
+    out.triangles.conservativeResize(row, 3);
+  }
+  return out;
 }
 
-}  // namespace articula::points::detail
+}  // namespace articula::points

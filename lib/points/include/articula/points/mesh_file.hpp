@@ -1,0 +1,23 @@
+#pragma once
+// The project's one reader of mesh files (.stl, .obj, .vtp, .vtk, .ply),
+// through VTK's readers with their errors collected instead of printed and
+// the checks VTK does not make (a binary STL's size, an OBJ's indices): the
+// mesh stage's input and the vertices a point file may be. Eigen out, VTK
+// stays inside lib/points.
+#include <filesystem>
+
+#include <Eigen/Core>
+
+namespace articula::points {
+
+struct MeshFile {
+  Eigen::MatrixX3d vertices;   // #V x 3, LPS millimetres
+  Eigen::MatrixX3d normals;    // #V x 3 point normals as the file has them, or 0 rows
+  Eigen::MatrixX3i triangles;  // #F x 3, 0-based (polygons triangulated), possibly 0 rows
+};
+
+/// Reads a mesh by extension (case-insensitive). Throws InputError naming
+/// the file: missing, another extension, VTK's first error, no vertices.
+MeshFile readMeshFile(const std::filesystem::path& path);
+
+}  // namespace articula::points
