@@ -44,14 +44,8 @@ class SimulateCommand : public cli::Command {
     fs::remove(summary_path);  // until the new one is written, the folder is unfinished
     log::info("simulating " + std::to_string(scene.bodies.size()) + " bodies, " + std::to_string(scene.contacts.size()) +
               " contacts, " + std::to_string(scene.duration) + " s");
-    int shown = 0;
-    const dynamics::SimulationSummary s = dynamics::simulateScene(scene, output_, [&](double t) {
-      const int tenth = static_cast<int>(std::floor(10 * t / scene.duration));
-      if (tenth > shown) {
-        shown = tenth;
-        log::info("simulate: " + std::to_string(10 * tenth) + " %");
-      }
-    });
+    const dynamics::SimulationSummary s = dynamics::simulateScene(
+        scene, output_, [&](double t) { log::progress("simulate", t / scene.duration); });
     nlohmann::json summary = s.toJson();
     summary["scene"] = scene_path_.string();
     summary["outputs"] = dynamics::simulationOutputs();

@@ -1,6 +1,10 @@
 #include "articula/core/log.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <iostream>
 #include <mutex>
 
@@ -26,6 +30,27 @@ void info(const std::string& m) {
 }
 void debug(const std::string& m) {
   if (g_level >= Level::Verbose) print("debug: ", m);
+}
+
+void progress(const std::string& what, double fraction) {
+  if (g_level < Level::Normal) return;
+  const int percent = static_cast<int>(std::floor(100 * std::clamp(fraction, 0.0, 1.0)));
+  static const bool terminal = isatty(STDERR_FILENO) != 0;
+  static std::string current;
+  static int shown = -1;  // percent on a terminal, tenths otherwise
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (what != current) current = what, shown = -1;
+  if (terminal) {
+    if (percent == shown) return;
+    shown = percent;
+    const int filled = percent / 5;
+    std::cerr << "\rarticula: " << what << " [" << std::string(static_cast<size_t>(filled), '#')
+              << std::string(static_cast<size_t>(20 - filled), ' ') << "] " << percent << " %" << (percent == 100 ? "\n" : "")
+              << std::flush;
+  } else if (percent / 10 > shown) {
+    shown = percent / 10;
+    std::cerr << "articula: " << what << ": " << 10 * shown << " %\n";
+  }
 }
 
 }  // namespace articula::log

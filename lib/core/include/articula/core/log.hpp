@@ -18,4 +18,9 @@ void info(const std::string& message);
 /// Printed only with --verbose.
 void debug(const std::string& message);
 
+/// Progress of work that takes more than a second (`fraction` of it done,
+/// 0 to 1), unless --quiet: a bar redrawn in place when stderr is a
+/// terminal, else a plain line at every tenth ("articula: <what>: 40 %").
+void progress(const std::string& what, double fraction);
+
 }  // namespace articula::log
