@@ -21,6 +21,8 @@ class ReportCommand : public cli::Command {
     app.add_option("-i,--input", options_.folder, "Subject folder holding fits.json, errors/summary.json and points.ply")
         ->required();
     app.add_option("--ct", options_.ct, "The subject's CT (recorded in results.json; hashed when it is a file)");
+    app.add_option("--series-uid", options_.series_uid,
+                   "Series Instance UID of the CT in a DICOM folder holding several (for the slices of report.html)");
     app.add_option("--joint", options_.joint, "hip or shoulder (recorded)")
         ->check(CLI::IsMember({"hip", "shoulder"}))
         ->capture_default_str();

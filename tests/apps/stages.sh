@@ -16,7 +16,7 @@ assert names == ["segment", "mesh", "sample", "fit", "errors", "report"], names
 by = {s["name"]: s for s in stages}
 assert "series-uid" in by["segment"]["options"] and "series-uid" in by["mesh"]["options"]
 assert "smoothing" in by["mesh"]["options"], by["mesh"]
-assert by["report"]["options"] == ["selection-tolerance", "selection-floor"], by["report"]
+assert by["report"]["options"] == ["series-uid", "selection-tolerance", "selection-floor"], by["report"]
 assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html"]
 assert "CT" in by["mesh"]["inputs"]
 # Every stage's command line names the files it reads and the first it writes

@@ -41,7 +41,7 @@ const std::vector<StageDescription>& stages() {
        {"-i", "{folder}/points.ply", "--fits", "{folder}/fits.json", "-o", "{folder}/errors"}},
       {"report",
        "Results, the selected model and the head's checks from the stage outputs",
-       {"selection-tolerance", "selection-floor"},
+       {"series-uid", "selection-tolerance", "selection-floor"},
        {"fits.json", "errors/summary.json", "points.ply"},
        {"results.json", "results.csv", "head.mrk.json", "report.html"},
        {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"}},

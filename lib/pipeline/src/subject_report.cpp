@@ -90,7 +90,9 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const json& results
     const std::string selected = results.value("selected_model", "");
     for (const auto& shape : fit::shapesFromFitsJson(readStageJson(o.folder / "fits.json"), "fits.json"))
       if (geometry::modelName(shape.model) == selected) model = shape;
-    const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, {});
+    imaging::ReadOptions read;
+    read.series_uid = o.series_uid;
+    const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, read);
     std::optional<imaging::Label> label;
     if (fs::exists(o.folder / "label.nii.gz")) label = imaging::readLabel(o.folder / "label.nii.gz");
     return headSlicesHtml(*ct, label ? &*label : nullptr, model, 1.6 * model.radii.maxCoeff(),

@@ -22,7 +22,8 @@ constexpr double kDefaultSelectionFloorMm = 0.03;
 
 struct SubjectReportOptions {
   std::filesystem::path folder;  // holds fits.json, errors/summary.json, points.ply (and label.nii.gz.json)
-  std::filesystem::path ct;      // the subject's CT (recorded; hashed when it is a file)
+  std::filesystem::path ct;      // the subject's CT (recorded; hashed when it is a file; sliced for report.html)
+  std::string series_uid;        // the CT's series, in a DICOM folder of several
   std::string joint = "hip", side = "right";
   double selection_tolerance = kDefaultSelectionTolerance;
   double selection_floor_mm = kDefaultSelectionFloorMm;
