@@ -24,6 +24,7 @@
 #include "articula/report/error_map_svg.hpp"
 #include "articula/report/error_statistics.hpp"
 #include "articula/report/histogram_svg.hpp"
+#include "articula/mesh/mesh.hpp"
 #include "articula/report/ply_writers.hpp"
 
 namespace articula::apps {
@@ -138,6 +139,7 @@ class ErrorsCommand : public cli::Command {
                                   input_.filename().string();
       writeFileAtomically(output_ / ("points_" + name + ".ply"),
                           report::colouredPointsPly(P, d, band_mm_, comment), overwrite);
+      mesh::writePointValues(output_ / ("points_" + name + ".vtp"), P, "signed_distance_mm", d, overwrite);
       const auto surface = geometry::makeSurface(shapes[m]);
       const geometry::SurfaceMesh patch = surfacePatch(*surface, P, resolution_);
       writeFileAtomically(output_ / ("surface_" + name + ".ply"),

@@ -1,1 +1,1 @@
-target_link_libraries(${test_name} PRIVATE articula_phantom)
+target_link_libraries(${test_name} PRIVATE articula_phantom articula_points)

@@ -2,11 +2,13 @@
 // in LPS, whether the grid is stored LPS or RAS (no mirroring, no shift),
 // with outward normals; file round trips; an empty label is refused.
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
 #include "articula/mesh/mesh.hpp"
+#include "articula/points/point_io.hpp"
 #include "ct_test_support.hpp"
 
 namespace articula {
@@ -92,6 +94,24 @@ TEST(Mesh, FileRoundTripsKeepVerticesAndTriangles) {
   }
   EXPECT_THROW(mesh::writeMesh(dir / "m.obj", m), UsageError);
   EXPECT_THROW(mesh::readMesh(dir / "missing.vtp"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+// Point values for Slicer and ParaView: the points come back, and the values
+// are the active scalars under their name (not colours), with the frame stated.
+TEST(Mesh, PointValuesAreActiveScalarsOfAVtpCloud) {
+  const auto dir = testing::scratch("values");
+  Eigen::MatrixX3d points(3, 3);
+  points << 1.5, -2, 3, 4, 5.25, -6, 7, 8, 9.5;
+  const Eigen::VectorXd d = Eigen::Vector3d(-0.25, 0.0, 0.75);
+  mesh::writePointValues(dir / "p.vtp", points, "signed_distance_mm", d);
+  const points::PointCloud back = points::readPoints(dir / "p.vtp");
+  EXPECT_LT((back.positions - points).cwiseAbs().maxCoeff(), 1e-5);
+  std::ifstream in(dir / "p.vtp", std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Scalars=\"signed_distance_mm\""), std::string::npos) << text.substr(0, 400);
+  EXPECT_NE(text.find("Name=\"SPACE\""), std::string::npos);
+  EXPECT_THROW(mesh::writePointValues(dir / "p.ply", points, "d", d), UsageError);
   std::filesystem::remove_all(dir);
 }
 

@@ -21,6 +21,7 @@
 #include <vtkSmoothPolyDataFilter.h>
 #include <vtkStringArray.h>
 #include <vtkFieldData.h>
+#include <vtkDoubleArray.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowedSincPolyDataFilter.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -277,14 +278,16 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   if (summary) *summary = s;
 }
 
-void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
+namespace {
+
+// Writes `poly` as .vtp, .stl or .ply (by extension) atomically, with its frame stated.
+void writePolyData(const fs::path& path, vtkPolyData* poly, bool overwrite) {
   if (!overwrite && fs::exists(path)) throw UsageError("refusing to overwrite " + path.string() + " (use --force)");
   const std::string ext = extensionOf(path);
   const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(folder, ec);
   const fs::path temp = temporaryPathFor(path);
-  const vtkSmartPointer<vtkPolyData> poly = toVtk(mesh);
   // How 3D Slicer learns a mesh's frame: "SPACE=LPS" in an STL header or a
   // PLY comment, a string array SPACE in VTK field data (without it Slicer
   // assumes LPS too, but says so only in its log).
@@ -323,6 +326,34 @@ void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
   }
   fs::rename(temp, path, ec);
   if (ec) throw InputError("could not rename the finished mesh to " + path.string());
+}
+
+}  // namespace
+
+void writeMesh(const fs::path& path, const TriangleMesh& mesh, bool overwrite) {
+  writePolyData(path, toVtk(mesh), overwrite);
+}
+
+void writePointValues(const fs::path& path, const Eigen::MatrixX3d& points, const std::string& name,
+                      const Eigen::VectorXd& values, bool overwrite) {
+  if (extensionOf(path) != ".vtp") throw UsageError("expected a .vtp file for point values, found '" + path.string() + "'");
+  if (values.size() != points.rows())
+    throw ProcessingError("writePointValues: " + std::to_string(values.size()) + " values for " +
+                          std::to_string(points.rows()) + " points");
+  vtkNew<vtkPoints> vtk_points;
+  vtkNew<vtkCellArray> vertices;
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(name.c_str());
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const vtkIdType id = vtk_points->InsertNextPoint(points(i, 0), points(i, 1), points(i, 2));
+    vertices->InsertNextCell(1, &id);
+    array->InsertNextValue(values[i]);
+  }
+  vtkNew<vtkPolyData> poly;
+  poly->SetPoints(vtk_points);
+  poly->SetVerts(vertices);
+  poly->GetPointData()->SetScalars(array);
+  writePolyData(path, poly, overwrite);
 }
 
 TriangleMesh readMesh(const fs::path& path) {

@@ -71,6 +71,11 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
 
 /// Writes .vtp, .stl or .ply (chosen by extension) atomically.
 void writeMesh(const std::filesystem::path& path, const TriangleMesh& mesh, bool overwrite = true);
+/// Points with one value each (say signed distances) as a .vtp point cloud
+/// whose active scalars are the values under `name`: 3D Slicer and ParaView
+/// colour it by the values themselves (a PLY would hand them RGB only).
+void writePointValues(const std::filesystem::path& path, const Eigen::MatrixX3d& points, const std::string& name,
+                      const Eigen::VectorXd& values, bool overwrite = true);
 /// Reads .vtp, .stl, .ply, .vtk or .obj; computes normals if the file has none.
 /// Throws InputError for a missing or unreadable file or a mesh with no triangles.
 TriangleMesh readMesh(const std::filesystem::path& path);
