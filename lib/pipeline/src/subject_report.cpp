@@ -83,12 +83,12 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
 // The report's CT slices through the selected model, or a note why there
 // are none (no CT given, one that cannot be read without options the report
 // does not take, a model that cannot be drawn): they show, they decide nothing.
-std::string slicesThroughHead(const SubjectReportOptions& o, const json& results) {
+std::string slicesThroughHead(const SubjectReportOptions& o, const std::vector<geometry::ShapeParameters>& shapes,
+                              const std::string& selected) {
   try {
     if (o.ct.empty()) return "<p class=\"note\">No CT given (--ct).</p>";
     geometry::ShapeParameters model;
-    const std::string selected = results.value("selected_model", "");
-    for (const auto& shape : fit::shapesFromFitsJson(readStageJson(o.folder / "fits.json"), "fits.json"))
+    for (const auto& shape : shapes)
       if (geometry::modelName(shape.model) == selected) model = shape;
     imaging::ReadOptions read;
     read.series_uid = o.series_uid;
@@ -224,7 +224,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"provenance", provenanceJson(provenance)}};
   writeFileAtomically(o.folder / "results.csv", csvLine(csv_header) + "\n" + csv_rows);
   writeFileAtomically(o.folder / "results.json", results.dump(2) + "\n");
-  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder, slicesThroughHead(o, results)));
+  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder, slicesThroughHead(o, shapes, selection.selected)));
   return qc;
 }
 
