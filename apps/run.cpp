@@ -22,6 +22,7 @@
 #include "articula/core/number_text.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
+#include "articula/core/version.hpp"
 #include "articula/imaging/io.hpp"
 #include "articula/pipeline/stages.hpp"
 
@@ -104,7 +105,8 @@ class RunCommand : public cli::Command {
       for (const auto& in : plan.inputs)
         if (!fs::exists(in))
           throw InputError("stage " + stage.name + " needs '" + in.string() + "', which is missing: run the earlier stages first");
-      json stamp = {{"args", plan.args}, {"inputs", json::object()}};
+      // Another build of articula reruns every stage: its outputs may differ.
+      json stamp = {{"articula", versionString()}, {"args", plan.args}, {"inputs", json::object()}};
       for (const auto& in : plan.inputs) stamp["inputs"][in.string()] = hashInput(in);
       const fs::path stamp_path = output_ / ".articula" / (stage.name + ".json");
       const bool forced = common.force || (!from_.empty() && i == first);
@@ -174,7 +176,9 @@ class RunCommand : public cli::Command {
     const std::optional<json> old = readJsonFileIfValid(stamp_path);
     if (!old) return false;
     try {
-      if (!(old->at("args") == stamp.at("args") && old->at("inputs") == stamp.at("inputs"))) return false;
+      if (!(old->value("articula", "") == stamp.at("articula") && old->at("args") == stamp.at("args") &&
+            old->at("inputs") == stamp.at("inputs")))
+        return false;
       for (const auto& out : plan.outputs)
         if (old->at("outputs").value(out.string(), "") != hashInput(out)) return false;
       return true;

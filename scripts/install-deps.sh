@@ -11,6 +11,8 @@ PACKAGES=(
   libgtest-dev libbenchmark-dev
   # measured peers (contact benchmarks) and the multibody engine
   libsimbody-dev libfcl-dev libccd-dev libbullet-dev
+  # the reports' inlined 3-D view; the browser and schema checks of the tests
+  libjs-three chromium python3-jsonschema
   # studies that outgrow one machine (pipelines/Snakefile)
   snakemake
   # fuzzing the readers (scripts/fuzz.sh): Clang and its libFuzzer runtime

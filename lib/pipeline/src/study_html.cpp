@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "articula/report/html_page.hpp"
 #include "articula/report/markup_text.hpp"
 #include "articula/report/strip_plot_svg.hpp"
 #include "results_json.hpp"
@@ -101,8 +102,7 @@ std::string studyReportHtml(const json& study, const std::vector<std::pair<std::
   look += "</table>\n";
   const json& provenance = member(study, "provenance");
   std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>articula study</title>\n<style>"
-       << kStyle << "</style></head>\n<body>\n<h1>articula study</h1>\n<p id=\"counts\">" << subjects.size()
+  html << report::htmlPageStart("articula study", kStyle) << "<h1>articula study</h1>\n<p id=\"counts\">" << subjects.size()
        << " subjects: <span id=\"succeeded\">" << numberAt(study, "succeeded") << "</span> finished, <span id=\"failed\">"
        << numberAt(study, "failed") << "</span> failed, <span id=\"flagged\">" << flagged
        << "</span> flagged by their checks.</p>\n<section id=\"look\"><h2>Subjects to look at</h2>\n" << look

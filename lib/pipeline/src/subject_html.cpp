@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "articula/core/json_file.hpp"
+#include "articula/report/html_page.hpp"
 #include "articula/report/markup_text.hpp"
 #include "results_json.hpp"
 
@@ -181,16 +182,19 @@ table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding
 th{background:#f4f4f4}.status{font-size:1.3em}.status.pass{color:#176f2c}.status.warn{color:#a15c00}
 .status.fail{color:#b00020}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}figure{margin:1em 0}
 figure svg{max-width:100%;height:auto}.slices{display:flex;flex-wrap:wrap;gap:.5em}
-.slices figure{margin:0}.note{color:#666;font-size:.9em}code{font-size:.9em})";
+.slices figure{margin:0}
+.view3d-controls label{margin-right:1em}.colour-bar{display:flex;align-items:center;gap:.5em;max-width:960px;margin:.3em 0}
+.colour-bar .bar{flex:1;height:12px;border:1px solid #999}.note{color:#666;font-size:.9em}code{font-size:.9em})";
 
 }  // namespace
 
-std::string subjectReportHtml(const json& results, const fs::path& folder, const std::string& slices_html) {
+std::string subjectReportHtml(const json& results, const fs::path& folder, const std::string& slices_html,
+                              const std::string& view_html) {
   const std::string title = "articula: " + results.value("side", "") + " " + results.value("joint", "") + " head";
-  std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" + report::escapeMarkup(title) +
-                     "</title>\n<style>" + kStyle + "</style></head>\n<body>\n<h1>" + report::escapeMarkup(title) + "</h1>\n<p>" +
+  std::string html = report::htmlPageStart(title, kStyle) + "<h1>" + report::escapeMarkup(title) + "</h1>\n<p>" +
                      report::escapeMarkup(results.value("input", "")) + "</p>\n";
   html += verdictSection(results);
+  html += view_html;
   html += "<section id=\"slices\"><h2>CT through the head</h2>\n<p class=\"note\">The selected model's outline in "
           "magenta, the segmentation's edge in yellow; radiological view (the patient's left on the right).</p>\n" +
           slices_html + "</section>\n";

@@ -22,6 +22,7 @@
 #include "articula/pipeline/markups.hpp"
 #include "articula/imaging/io.hpp"
 #include "articula/pipeline/head_slices.hpp"
+#include "articula/pipeline/head_view.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
 #include "articula/points/point_io.hpp"
@@ -224,7 +225,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"provenance", provenanceJson(provenance)}};
   writeFileAtomically(o.folder / "results.csv", csvLine(csv_header) + "\n" + csv_rows);
   writeFileAtomically(o.folder / "results.json", results.dump(2) + "\n");
-  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder, slicesThroughHead(o, shapes, selection.selected)));
+  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder, slicesThroughHead(o, shapes, selection.selected),
+                                                                    headViewHtml(o.folder, shapes, selection.selected)));
   return qc;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // report.html: a subject's results as one self-contained page that opens
-// offline (no external resource, no script): the verdict first (the head's
-// checks and their reasons, the selected model, the head centre and radii
-// with 95 % intervals), CT slices through the head with the segmentation's
+// offline (no external resource; a content security policy forbids any
+// request): the verdict first (the head's checks and their reasons, the
+// selected model, the head centre and radii with 95 % intervals), an
+// interactive 3-D view (head_view.hpp), CT slices through the head with the segmentation's
 // edge and the model's outline (head_slices.hpp), the checks, the five
 // models, the error figures of the errors stage inline, and an About section (version, commit, command,
 // date, parameters, input hashes and a methods paragraph generated from the
@@ -18,8 +19,9 @@ namespace articula::pipeline {
 /// The page for `results` (results.json's document) of the subject in
 /// `folder` (its errors/*.svg inlined; points.ply.json, label.nii.gz.json
 /// and bone.vtp.json read for the methods, when present), with the CT
-/// slices' figures (or a note why there are none) as given.
+/// slices' figures and the 3-D view's section (or notes why there are none)
+/// as given.
 std::string subjectReportHtml(const nlohmann::json& results, const std::filesystem::path& folder,
-                              const std::string& slices_html);
+                              const std::string& slices_html, const std::string& view_html);
 
 }  // namespace articula::pipeline
