@@ -5,8 +5,6 @@
 #include "articula/core/csv.hpp"
 #include "articula/core/error.hpp"
 #include "articula/points/mesh_file.hpp"
-#include "articula/report/markup_text.hpp"
-#include "articula/report/web_3d_view.hpp"
 
 namespace articula::pipeline {
 namespace {
@@ -48,9 +46,9 @@ double cell(const CsvTable& table, size_t row, int column, const fs::path& path)
 
 }  // namespace
 
-std::string headViewHtml(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
-                         const std::string& selected_model) {
-  try {
+report::View3d loadHeadView(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
+                            const std::string& selected_model) {
+  {
     report::View3d view;
     view.selected_model = selected_model;
     for (const auto& shape : shapes)
@@ -85,10 +83,7 @@ std::string headViewHtml(const fs::path& folder, const std::vector<geometry::Sha
         view.fitted.push_back({model, m.vertices, m.triangles});
       }
     }
-    return report::web3dViewHtml(view);
-  } catch (const Error& e) {
-    return "<section id=\"view3d\"><h2>3-D view</h2><p class=\"note\">No 3-D view: " + report::escapeMarkup(e.what()) +
-           "</p></section>\n";
+    return view;
   }
 }
 

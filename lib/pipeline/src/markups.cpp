@@ -18,23 +18,47 @@ nlohmann::json markup(const std::string& type, const std::string& name, nlohmann
           {"locked", true},
           {"controlPoints", std::move(control_points)}};
 }
-}  // namespace
 
-void writeSlicerMarkups(const std::filesystem::path& path, const std::string& name,
-                        const std::vector<Landmark>& points, const std::vector<LandmarkLine>& lines) {
-  nlohmann::json markups = nlohmann::json::array();
-  nlohmann::json cps = nlohmann::json::array();
-  for (size_t i = 0; i < points.size(); ++i) cps.push_back(point(std::to_string(i + 1), points[i].label, points[i].position));
-  markups.push_back(markup("Fiducial", name, cps));
-  for (const auto& line : lines)
-    markups.push_back(markup("Line", line.label,
-                             {point("1", line.label + "_start", line.start), point("2", line.label + "_end", line.end)}));
+// The @schema Slicer 5.0 and later accept (5.0 matches this spelling exactly).
+void writeMarkupsDocument(const std::filesystem::path& path, nlohmann::json markups) {
   const nlohmann::json doc = {
       {"@schema",
        "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/Schema/"
        "markups-schema-v1.0.3.json#"},
-      {"markups", markups}};
+      {"markups", std::move(markups)}};
   writeFileAtomically(path, doc.dump(2) + "\n");
+}
+
+nlohmann::json pointList(const std::string& name, const std::vector<Landmark>& points) {
+  nlohmann::json cps = nlohmann::json::array();
+  for (size_t i = 0; i < points.size(); ++i) cps.push_back(point(std::to_string(i + 1), points[i].label, points[i].position));
+  return markup("Fiducial", name, cps);
+}
+
+nlohmann::json lineMarkup(const LandmarkLine& line) {
+  return markup("Line", line.label, {point("1", line.label + "_start", line.start), point("2", line.label + "_end", line.end)});
+}
+
+}  // namespace
+
+void writeSlicerMarkups(const std::filesystem::path& path, const std::string& name,
+                        const std::vector<Landmark>& points, const std::vector<LandmarkLine>& lines) {
+  nlohmann::json markups = nlohmann::json::array({pointList(name, points)});
+  for (const auto& line : lines) markups.push_back(lineMarkup(line));
+  writeMarkupsDocument(path, markups);
+}
+
+std::vector<MarkupFile> writeSlicerMarkupsPerNode(const std::filesystem::path& folder, const std::string& name,
+                                                  const std::vector<Landmark>& points,
+                                                  const std::vector<LandmarkLine>& lines) {
+  std::filesystem::create_directories(folder);
+  std::vector<MarkupFile> files = {{name, "points.mrk.json", false}};
+  writeMarkupsDocument(folder / files.back().file_name, nlohmann::json::array({pointList(name, points)}));
+  for (const auto& line : lines) {
+    files.push_back({line.label, line.label + ".mrk.json", true});
+    writeMarkupsDocument(folder / files.back().file_name, nlohmann::json::array({lineMarkup(line)}));
+  }
+  return files;
 }
 
 }  // namespace articula::pipeline

@@ -43,7 +43,7 @@ const std::vector<StageDescription>& stages() {
        "Results, the selected model and the head's checks from the stage outputs",
        {"series-uid", "selection-tolerance", "selection-floor"},
        {"fits.json", "errors/summary.json", "points.ply"},
-       {"results.json", "results.csv", "head.mrk.json", "report.html"},
+       {"results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"},
        {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"}},
   };
   return table;

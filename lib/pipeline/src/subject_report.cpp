@@ -23,6 +23,7 @@
 #include "articula/imaging/io.hpp"
 #include "articula/pipeline/head_slices.hpp"
 #include "articula/pipeline/head_view.hpp"
+#include "articula/pipeline/slicer_scene.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
 #include "articula/points/point_io.hpp"
@@ -192,6 +193,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   for (int i = 0; i < 3; ++i)
     axes.push_back({axis_names[i], c - best_shape.radii[i] * R.col(i), c + best_shape.radii[i] * R.col(i)});
   writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
+  SlicerSceneContent scene;
+  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
 
   const QcReport qc = checkSubjectHead(o.folder, shapes);
 
@@ -225,8 +228,24 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"provenance", provenanceJson(provenance)}};
   writeFileAtomically(o.folder / "results.csv", csvLine(csv_header) + "\n" + csv_rows);
   writeFileAtomically(o.folder / "results.json", results.dump(2) + "\n");
-  writeFileAtomically(o.folder / "report.html", subjectReportHtml(results, o.folder, slicesThroughHead(o, shapes, selection.selected),
-                                                                    headViewHtml(o.folder, shapes, selection.selected)));
+  // The 3-D view and the Slicer scene show the same colourings.
+  std::string view_html;
+  scene.selected_model = selection.selected;
+  scene.bone = fs::exists(o.folder / "bone.vtp");
+  for (const auto& shape : shapes)
+    if (fs::exists(o.folder / "errors" / ("points_" + geometry::modelName(shape.model) + ".vtp")))
+      scene.models.push_back(geometry::modelName(shape.model));
+  try {
+    const report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
+    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = report::symmetricColourRange(d.signed_distance_mm);
+    view_html = report::web3dViewHtml(view);
+  } catch (const Error& e) {
+    view_html = "<section id=\"view3d\"><h2>3-D view</h2><p class=\"note\">No 3-D view: " + report::escapeMarkup(e.what()) +
+                "</p></section>\n";
+  }
+  writeFileAtomically(o.folder / "scene.mrml", slicerSceneXml(scene));
+  writeFileAtomically(o.folder / "report.html",
+                      subjectReportHtml(results, o.folder, slicesThroughHead(o, shapes, selection.selected), view_html));
   return qc;
 }
 

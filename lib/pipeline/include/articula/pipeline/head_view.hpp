@@ -8,13 +8,14 @@
 #include <vector>
 
 #include "articula/geometry/shape.hpp"
+#include "articula/report/web_3d_view.hpp"
 
 namespace articula::pipeline {
 
-/// The view's section, turning about the selected model's centre, or a note
-/// why there is none (a stage output missing or unreadable): the view
-/// shows, it decides nothing.
-std::string headViewHtml(const std::filesystem::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
-                         const std::string& selected_model);
+/// The view, turning about the selected model's centre. Throws InputError
+/// when errors/errors.csv is missing or unreadable (bone.vtp and the
+/// surfaces are shown when they are there).
+report::View3d loadHeadView(const std::filesystem::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
+                            const std::string& selected_model);
 
 }  // namespace articula::pipeline
