@@ -17,7 +17,7 @@ by = {s["name"]: s for s in stages}
 assert "series-uid" in by["segment"]["options"] and "series-uid" in by["mesh"]["options"]
 assert "smoothing" in by["mesh"]["options"], by["mesh"]
 assert by["report"]["options"] == ["series-uid", "selection-tolerance", "selection-floor"], by["report"]
-assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html"]
+assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"]
 assert "CT" in by["mesh"]["inputs"]
 # Every stage's command line names the files it reads and the first it writes
 # (the others go beside it: fits.csv beside fits.json); the report reads its folder.
@@ -52,14 +52,16 @@ assert r["selected_model"] == sys.argv[2], (r["selected_model"], sys.argv[2])
 assert "articula-report -i " in r["provenance"]["command"], r["provenance"]["command"]
 assert r["qc"]["status"] in ("pass", "warn"), r["qc"]
 PY
-# report.html: self-contained (no script, stylesheet or image from elsewhere),
+# report.html: self-contained (no script, stylesheet or image from elsewhere;
+# a policy that forbids requests),
 # its numbers those of results.json, both error figures inline.
 python3 - "$tmp/r/report.html" "$tmp/r/results.json" <<'PY'
 import json, re, sys
 html, r = open(sys.argv[1]).read(), json.load(open(sys.argv[2]))
 assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
-assert not re.search(r'<(script|link|img|iframe)\b', html), "external or active content"
-assert not re.search(r'(src|href)\s*=\s*"(?!#|data:image/png;base64,)', html), "a reference leaves the page"
+assert not re.search(r'<(link|img|iframe)\b|<script[^>]*\bsrc\b', html), "external content"
+assert "content=\"default-src 'none';" in html, "no content security policy"
+assert not re.search(r'\b(src|href)\s*=\s*"(?!#|data:image/png;base64,)', html), "a reference leaves the page"
 # Three CT slices through the head, each an embedded PNG with the label's edge and the model's outline.
 import base64, struct
 slices = re.findall(r'<svg[^>]*class="slice" data-plane="(\w+)".*?href="data:image/png;base64,([^"]+)".*?'
