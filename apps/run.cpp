@@ -115,7 +115,7 @@ class RunCommand : public cli::Command {
         continue;
       }
       fs::remove(stamp_path);
-      log::info("run: " + stage.name + " ...");
+      log::info("run: [" + std::to_string(i - first + 1) + "/" + std::to_string(last - first + 1) + "] " + stage.name + " ...");
       const auto t0 = std::chrono::steady_clock::now();
       const int rc = cli::runCommandInProcess(stage.name, plan.args);
       if (rc != 0) return rc;  // the stage has said why on stderr

@@ -61,7 +61,7 @@ print(a[a.index("-i") + 1], a[a.index("--seed") + 1])' "$dir/.articula/segment.j
 for stage in segment mesh sample fit errors; do
   grep -q "run: $stage is up to date" "$tmp/tolerance.err" || { cat "$tmp/tolerance.err" >&2; fail "$stage was redone"; }
 done
-grep -q "run: report \.\.\." "$tmp/tolerance.err" || { cat "$tmp/tolerance.err" >&2; fail "the report was not redone"; }
+grep -q "run: \[6/6\] report \.\.\." "$tmp/tolerance.err" || { cat "$tmp/tolerance.err" >&2; fail "the report was not redone"; }
 python3 - "$dir/results.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))

@@ -30,6 +30,7 @@
 #include "articula/core/error.hpp"
 #include "articula/imaging/edges.hpp"
 #include "articula/points/mesh_file.hpp"
+#include "articula/points/vtk_mesh.hpp"
 
 namespace articula::mesh {
 namespace fs = std::filesystem;
@@ -79,33 +80,9 @@ vtkSmartPointer<vtkPolyData> withNormals(vtkPolyData* input) {
 }
 
 TriangleMesh fromVtk(vtkPolyData* poly) {
-  TriangleMesh mesh;
-  const vtkIdType n = poly->GetNumberOfPoints();
-  mesh.vertices.resize(n, 3);
-  for (vtkIdType v = 0; v < n; ++v) {
-    double p[3];
-    poly->GetPoint(v, p);
-    mesh.vertices.row(v) << p[0], p[1], p[2];
-  }
-  if (vtkDataArray* normals = poly->GetPointData()->GetNormals()) {
-    mesh.normals.resize(n, 3);
-    for (vtkIdType v = 0; v < n; ++v) {
-      double q[3];
-      normals->GetTuple(v, q);
-      mesh.normals.row(v) = Eigen::RowVector3d(q[0], q[1], q[2]).normalized();
-    }
-  }
-  std::vector<Eigen::Vector3i> triangles;
-  vtkCellArray* polys = poly->GetPolys();
-  polys->InitTraversal();
-  vtkIdType count = 0;
-  const vtkIdType* ids = nullptr;
-  while (polys->GetNextCell(count, ids))
-    if (count == 3)
-      triangles.emplace_back(static_cast<int>(ids[0]), static_cast<int>(ids[1]), static_cast<int>(ids[2]));
-  mesh.triangles.resize(static_cast<Eigen::Index>(triangles.size()), 3);
-  for (size_t t = 0; t < triangles.size(); ++t) mesh.triangles.row(static_cast<Eigen::Index>(t)) = triangles[t].transpose();
-  return mesh;
+  points::MeshFile m = points::meshFromPolyData(poly);
+  for (Eigen::Index v = 0; v < m.normals.rows(); ++v) m.normals.row(v) = Eigen::RowVector3d(m.normals.row(v)).normalized();
+  return {std::move(m.vertices), std::move(m.normals), std::move(m.triangles)};
 }
 
 vtkSmartPointer<vtkPolyData> toVtk(const TriangleMesh& mesh) {

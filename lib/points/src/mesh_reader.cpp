@@ -28,6 +28,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/points/mesh_file.hpp"
+#include "articula/points/vtk_mesh.hpp"
 #include "readers.hpp"
 
 namespace articula::points::detail {
@@ -235,8 +236,13 @@ MeshFile readMeshFile(const std::filesystem::path& path) {
   if (points == nullptr || points->GetNumberOfPoints() == 0)
     throw InputError("mesh file " + quoted(path) + ": expected vertices, found none");
 
+  return meshFromPolyData(poly);
+}
+
+MeshFile meshFromPolyData(vtkPolyData* poly) {
   MeshFile out;
-  const vtkIdType n = points->GetNumberOfPoints();
+  vtkPoints* points = poly->GetPoints();
+  const vtkIdType n = points ? points->GetNumberOfPoints() : 0;
   out.vertices.resize(n, 3);
   for (vtkIdType i = 0; i < n; ++i) {
     double p[3];
@@ -253,13 +259,17 @@ MeshFile readMeshFile(const std::filesystem::path& path) {
     }
   }
   if (poly->GetNumberOfPolys() > 0) {
-    // Polygons as triangles; the filter keeps the points (and their order).
+    // Polygons as triangles (the filter keeps the points and their order);
+    // triangles as they are, in their order.
+    vtkCellArray* cells = poly->GetPolys();
     vtkNew<vtkTriangleFilter> triangulate;
-    triangulate->SetInputData(poly);
-    triangulate->PassLinesOff();
-    triangulate->PassVertsOff();
-    triangulate->Update();
-    vtkCellArray* cells = triangulate->GetOutput()->GetPolys();
+    if (cells->IsHomogeneous() != 3) {
+      triangulate->SetInputData(poly);
+      triangulate->PassLinesOff();
+      triangulate->PassVertsOff();
+      triangulate->Update();
+      cells = triangulate->GetOutput()->GetPolys();
+    }
     out.triangles.resize(cells->GetNumberOfCells(), 3);
     vtkIdType row = 0, count = 0;
     const vtkIdType* ids = nullptr;
