@@ -119,6 +119,8 @@ if command -v snakemake > /dev/null; then
   diff "$tmp/batch-good/study.csv" "$tmp/snake/study.csv" || fail "snakemake study.csv differs from batch"
   diff "$tmp/batch-good/study_summary.csv" "$tmp/snake/study_summary.csv" || fail "study_summary.csv differs"
   [ "$(grep -c '<g class="subject">' "$tmp/snake/study.svg")" -eq 2 ] || fail "snakemake study.svg"
+  grep -q "subjects/p1/report.html" "$tmp/snake/study.html" || fail "snakemake study.html does not link the subjects' reports"
+  [ -s "$tmp/snake/subjects/p1/scene.mrml" ] || fail "snakemake wrote no scene.mrml"
   [ -s "$tmp/snake/subjects/p1/errors/error_map.svg" ] || fail "snakemake error_map.svg"
   # Same seed, same outputs (batch-good vs the first batch, subject p2).
   # The columns took effect: a 1 mm floor selects the sphere, and a wider
