@@ -273,5 +273,24 @@ TEST(ModelSelection, TheSimplestModelWithinTheToleranceOfTheLeastRms) {
   EXPECT_EQ(pipeline::selectParsimonious({{"sphere", 4, NAN}}).selected, "");
 }
 
+TEST(ModelSelection, ModelsThePointsLeaveOpenTakeNoPart) {
+  // The real thorax's right humeral head: the superellipsoid, ovoid and
+  // superovoid had radii or centres with 95 % intervals of +-15 to +-28 mm.
+  // With them, the ovoid (radii 33.8, 33.8, 14.9 mm) would be selected;
+  // without, the ellipsoid, the least RMS of the determined models.
+  std::vector<pipeline::ModelScore> shoulder = {{"sphere", 4, 0.4786},          {"ellipsoid", 9, 0.3957},
+                                                {"superellipsoid", 12, 0.3731}, {"ovoid", 15, 0.3418},
+                                                {"superovoid", 18, 0.3156}};
+  EXPECT_EQ(pipeline::selectParsimonious(shoulder).selected, "ovoid");
+  for (size_t i = 2; i < shoulder.size(); ++i) shoulder[i].determined = false;
+  const pipeline::ModelSelection s = pipeline::selectParsimonious(shoulder);
+  EXPECT_EQ(s.selected, "ellipsoid");
+  EXPECT_EQ(s.indistinguishable, std::vector<std::string>{"ellipsoid"});
+  EXPECT_EQ(s.undetermined, (std::vector<std::string>{"superellipsoid", "ovoid", "superovoid"}));
+  // None determined: all take part, as before.
+  for (auto& m : shoulder) m.determined = false;
+  EXPECT_EQ(pipeline::selectParsimonious(shoulder).selected, "ovoid");
+}
+
 }  // namespace
 }  // namespace articula

@@ -89,13 +89,18 @@ double bic(double sse, int n, int k) { return n * std::log(sse / n) + k * std::l
 ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance,
                                   double absolute_tolerance_mm) {
   ModelSelection out;
+  const bool any_determined =
+      std::any_of(scores.begin(), scores.end(), [](const ModelScore& s) { return s.determined && std::isfinite(s.rms_mm); });
+  auto candidate = [&](const ModelScore& s) { return std::isfinite(s.rms_mm) && (s.determined || !any_determined); };
   double least = INFINITY;
-  for (const auto& s : scores)
-    if (std::isfinite(s.rms_mm)) least = std::min(least, s.rms_mm);
+  for (const auto& s : scores) {
+    if (!s.determined) out.undetermined.push_back(s.model);
+    if (candidate(s)) least = std::min(least, s.rms_mm);
+  }
   if (!std::isfinite(least)) return out;
   const ModelScore* chosen = nullptr;
   for (const auto& s : scores) {
-    if (!(s.rms_mm <= least + std::max(relative_tolerance * least, absolute_tolerance_mm))) continue;
+    if (!candidate(s) || !(s.rms_mm <= least + std::max(relative_tolerance * least, absolute_tolerance_mm))) continue;
     out.indistinguishable.push_back(s.model);
     if (!chosen || s.n_parameters < chosen->n_parameters ||
         (s.n_parameters == chosen->n_parameters && s.rms_mm < chosen->rms_mm))

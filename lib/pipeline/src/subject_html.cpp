@@ -68,6 +68,11 @@ std::string verdictSection(const json& results) {
   }
   html += "<table><tr><th>selected model</th><td id=\"selected-model\">" + report::escapeMarkup(selected) +
           "</td></tr>\n<tr><th>least RMS</th><td>" + report::escapeMarkup(results.value("best_model", "")) + "</td></tr>\n";
+  std::string open_models;
+  for (const auto& m : member(member(results, "selection"), "undetermined"))
+    open_models += (open_models.empty() ? "" : ", ") + report::escapeMarkup(m.is_string() ? m.get<std::string>() : "");
+  if (!open_models.empty())
+    html += "<tr><th>not determined by the points (not selectable)</th><td id=\"undetermined\">" + open_models + "</td></tr>\n";
   if (const json* m = modelNamed(results, selected)) {
     html += "<tr><th>head centre (mm, LPS)</th><td id=\"head-centre\">" + withInterval(*m, "t1_mm", 2) + ", " +
             withInterval(*m, "t2_mm", 2) + ", " + withInterval(*m, "t3_mm", 2) + "</td></tr>\n";

@@ -48,6 +48,27 @@ std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
   return unit.empty() ? name : name + "_" + unit;
 }
 
+// Whether the points determine a model's centre, radii and exponents: none
+// of them among those fits.json calls not identifiable. Not counted: angles
+// (a spheroid's spin may be open; its shape is not), the ovoid terms, and
+// the ovoids' a and b, which only their products with c0x and c0y fix (a
+// scale shared by two parameters is open on every ovoid, true ones included).
+bool determinedByPoints(geometry::ShapeModel model, const json& not_identifiable) {
+  const auto names = geometry::parameterNames(model);
+  const auto kinds = geometry::parameterKinds(model);
+  const bool ovoid = model == geometry::ShapeModel::Ovoid || model == geometry::ShapeModel::Superovoid;
+  for (const auto& item : not_identifiable) {
+    const std::string name = item.is_string() ? item.get<std::string>() : "";
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) return false;
+    const geometry::ParameterKind kind = kinds[static_cast<size_t>(it - names.begin())];
+    const bool counted = kind == geometry::ParameterKind::Translation || kind == geometry::ParameterKind::Exponent ||
+                         (kind == geometry::ParameterKind::Radius && !(ovoid && (name == "a" || name == "b")));
+    if (counted) return false;
+  }
+  return true;
+}
+
 json readStageJson(const fs::path& path) {
   if (!fs::exists(path))
     throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
@@ -162,7 +183,11 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   }
   // The model these points support (see selectParsimonious).
   std::vector<ModelScore> scores;
-  for (const auto& m : models) scores.push_back({m.at("model"), m.at("n_parameters"), m.at("errors").value("rms_mm", NAN)});
+  for (size_t i = 0; i < models.size(); ++i) {
+    const json& m = models[i];
+    scores.push_back({m.at("model"), m.at("n_parameters"), m.at("errors").value("rms_mm", NAN),
+                      determinedByPoints(shapes[i].model, m.value("not_identifiable", json::array()))});
+  }
   const ModelSelection selection = selectParsimonious(scores, o.selection_tolerance, o.selection_floor_mm);
   csv_header.push_back("selected");
   // results.csv: one row per model, units in the column names.
@@ -215,11 +240,13 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"selected_model", selection.selected},
       {"selection",
        {{"rule",
-         "the simplest model whose RMS exceeds the least RMS by at most the larger of relative_tolerance x the least RMS "
-         "and absolute_tolerance_mm"},
+         "among the models whose centre, radii and exponents the points determine (not undetermined), the "
+         "simplest whose RMS exceeds their least RMS by at most the larger of relative_tolerance x that RMS and "
+         "absolute_tolerance_mm"},
         {"relative_tolerance", o.selection_tolerance},
         {"absolute_tolerance_mm", o.selection_floor_mm},
-        {"indistinguishable", selection.indistinguishable}}},
+        {"indistinguishable", selection.indistinguishable},
+        {"undetermined", selection.undetermined}}},
       {"head_center_mm", {c[0], c[1], c[2]}},
       {"qc", qc.toJson()},
       {"models", models},

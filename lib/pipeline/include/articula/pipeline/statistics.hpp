@@ -45,14 +45,24 @@ double bic(double sse, int n, int k);
 /// blur a thin cortex more along their long axis), which a more flexible
 /// model absorbs; on phantoms of known shape it leaves a true sphere 11-15 %
 /// (0.015-0.02 mm) above the ovoids.
+/// Only models the points determine take part: one whose centre, radii or
+/// exponents the points leave open (fit/uncertainty.hpp's not_identifiable;
+/// an angle may be open, as a spheroid's spin is, and so may the ovoid
+/// terms, whose scale the ovoids share with a and b) has
+/// bought its low RMS with freedom the data do not constrain, and its
+/// parameters would be reported as if measured. On a real shoulder an ovoid
+/// with radii at their bounds and +-28 mm intervals had the least RMS but
+/// one. When no model is determined, all take part.
 struct ModelScore {
   std::string model;
   int n_parameters = 0;
   double rms_mm = 0.0;
+  bool determined = true;
 };
 struct ModelSelection {
   std::string selected;
   std::vector<std::string> indistinguishable;  // in the order given
+  std::vector<std::string> undetermined;       // left out, in the order given
 };
 ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance = 0.10,
                                   double absolute_tolerance_mm = 0.03);
