@@ -81,6 +81,13 @@ assert re.search(r'id="rms">%.3f<' % model["errors"]["rms_mm"], html), "RMS diff
 for m in r["models"]:
     assert re.search(r'data-model="%s"><td>%s</td><td>%d</td><td class="rms">%.3f<' % (
         m["model"], m["model"], m["n_parameters"], m["errors"]["rms_mm"]), html), m["model"]
+# Semi-axes through the centre: the radii, or an ovoid's a c0x, b c0y, c.
+for m in r["models"]:
+    p, axes = m["parameters"], m["semi_axes_mm"]
+    want = [p["a_mm"] * p.get("c0x", 1), p.get("b_mm", p["a_mm"]) * p.get("c0y", 1), p.get("c_mm", p["a_mm"])]
+    assert all(abs(x - y) <= 1e-9 * y for x, y in zip(axes, want)), (m["model"], axes, want)
+    if "c0x" in p and m["model"] == selected:
+        assert re.search(r'id="semi-axes">%.2f, %.2f, %.2f' % tuple(axes), html), "semi-axes not shown"
 assert 'class="status %s"' % r["qc"]["status"] in html
 assert html.count("<svg") >= 2, "the error figures are not inline"
 methods = re.search(r'<p id="methods">(.*?)</p>', html, re.S).group(1)

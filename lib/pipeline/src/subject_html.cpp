@@ -81,6 +81,14 @@ std::string verdictSection(const json& results) {
     for (const char* key : {"a_mm", "b_mm", "c_mm"})
       if (parameters.contains(key)) radii += (radii.empty() ? "" : ", ") + withInterval(*m, key, 2);
     html += "<tr><th>radii (mm)</th><td id=\"radii\">" + radii + "</td></tr>\n";
+    const json& semi_axes = member(*m, "semi_axes_mm");
+    if (semi_axes.is_array() && semi_axes.size() == 3 && parameters.contains("c0x"))
+      html += "<tr><th>semi-axes through the centre (mm): a&middot;c0x, b&middot;c0y, c</th><td id=\"semi-axes\">" +
+              fixed(semi_axes[0].is_number() ? semi_axes[0].get<double>() : NAN, 2) + ", " +
+              fixed(semi_axes[1].is_number() ? semi_axes[1].get<double>() : NAN, 2) + ", " +
+              fixed(semi_axes[2].is_number() ? semi_axes[2].get<double>() : NAN, 2) +
+              " <span class=\"note\">(an ovoid's a and b share their scale with c0x and c0y; these products are its "
+              "shape)</span></td></tr>\n";
     html += "<tr><th>RMS error (mm)</th><td id=\"rms\">" +
             fixed(numberAt(member(*m, "errors"), "rms_mm"), 3) + "</td></tr>\n";
   }

@@ -162,6 +162,12 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     const int n = errors.value("n_points", 0);
     const double sse = errors.value("sse_mm2", 0.0);
     json entry = {{"model", name}, {"n_parameters", k}, {"parameters", parameters}, {"errors", errors}};
+    // The half widths through the centre along the local axes: an ovoid's
+    // a and b are scaled by c0x and c0y, and only the products are its shape.
+    const bool ovoid = shape.model == geometry::ShapeModel::Ovoid || shape.model == geometry::ShapeModel::Superovoid;
+    const double rb = shape.model == geometry::ShapeModel::Sphere ? shape.radii[0] : shape.radii[1];
+    const double rc = shape.model == geometry::ShapeModel::Sphere ? shape.radii[0] : shape.radii[2];
+    entry["semi_axes_mm"] = {shape.radii[0] * (ovoid ? shape.cx[0] : 1.0), rb * (ovoid ? shape.cy[0] : 1.0), rc};
     // Standard errors in the parameters' units (angles in degrees); null:
     // not identifiable from these points (fits.json, fit/uncertainty.hpp).
     if (fit_entry.contains("standard_errors_table_3_2")) {
