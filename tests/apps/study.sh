@@ -59,6 +59,10 @@ for s in ("p1", "p2"):
         err = sum((a - b) ** 2 for a, b in zip(centre, truth["head_center_mm"])) ** 0.5
         assert err < 1.5, (s, r["model"], err)
         assert float(r["rms_mm"]) < 0.5, (s, r["model"], r["rms_mm"])
+        # The semi-axes through the centre: a c0x for an ovoid, else a.
+        want = float(r["a_mm"]) * (float(r["c0x"]) if r["c0x"] else 1.0)
+        assert abs(float(r["semi_axis_a_mm"]) - want) <= 1e-6 * want, (s, r["model"], r["semi_axis_a_mm"], want)
+        assert r["determined"] in ("0", "1") and (r["selected"] != "1" or r["determined"] == "1"), r
 summary = {r["model"]: r for r in csv.DictReader(open(f"{study}/study_summary.csv"))}
 assert set(summary) == models and summary["sphere"]["n_subjects"] == "2"
 assert summary["ellipsoid"]["wilcoxon_p_vs_sphere"] != ""

@@ -40,6 +40,7 @@ struct ModelRow {
   bool best = false;
   bool selected = false;  // results.json's selected_model
   std::string qc_status, qc_reasons;  // results.json's qc (the subject's)
+  bool determined = true;  // not in results.json's selection.undetermined
 };
 
 // study.svg: RMS per model, subject by subject (subjects in manifest order).
@@ -82,9 +83,14 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
       for (const auto& reason : results.at("qc").value("reasons", nlohmann::json::array()))
         if (reason.is_string()) qc_reasons += (qc_reasons.empty() ? "" : "; ") + reason.get<std::string>();
     }
+    const nlohmann::json undetermined =
+        results.contains("selection") && results.at("selection").is_object()
+            ? results.at("selection").value("undetermined", nlohmann::json::array())
+            : nlohmann::json::array();
     for (const auto& m : results.at("models")) {
       ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best, m.at("model") == selected,
                    qc_status, qc_reasons};
+      row.determined = std::find(undetermined.begin(), undetermined.end(), m.at("model")) == undetermined.end();
       for (const auto& [key, value] : m.at("parameters").items())
         if (std::find(parameter_columns.begin(), parameter_columns.end(), key) == parameter_columns.end())
           parameter_columns.push_back(key);
@@ -97,7 +103,8 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   // study.csv
   std::vector<std::string> header = {"subject", "model", "n_parameters"};
   header.insert(header.end(), kErrorColumns.begin(), kErrorColumns.end());
-  header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected", "qc_status", "qc_reasons"});
+  header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected", "determined", "qc_status", "qc_reasons",
+                               "semi_axis_a_mm", "semi_axis_b_mm", "semi_axis_c_mm"});
   header.insert(header.end(), parameter_columns.begin(), parameter_columns.end());
   for (const auto& c : parameter_columns) header.push_back(c + "_se");  // standard errors, same units
   std::string study_csv = csvLine(header) + "\n";
@@ -108,8 +115,11 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     f.push_back(number(r.entry.value("bic", NAN)));
     f.push_back(r.best ? "1" : "0");
     f.push_back(r.selected ? "1" : "0");
+    f.push_back(r.determined ? "1" : "0");
     f.push_back(r.qc_status);
     f.push_back(r.qc_reasons);
+    const nlohmann::json axes = r.entry.value("semi_axes_mm", nlohmann::json::array());
+    for (size_t k = 0; k < 3; ++k) f.push_back(k < axes.size() && axes[k].is_number() ? number(axes[k].get<double>()) : "");
     for (const auto& c : parameter_columns)
       f.push_back(r.entry.at("parameters").contains(c) ? number(r.entry.at("parameters").at(c).get<double>()) : "");
     const nlohmann::json se = r.entry.value("standard_errors", nlohmann::json::object());
