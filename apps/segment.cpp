@@ -107,6 +107,7 @@ class SegmentCommand : public cli::Command {
         {"gantry_tilt_deg", report.gantry_tilt_deg},
         {"hu_window", {options_.hu_min, options_.hu_max}},
         {"seed_source", s.seed_source},
+        {"side_check", s.side_check},
         {"seed_mm", vec(s.seed_mm)},
         {"head_center_mm", vec(s.head_center_mm)},
         {"search_radius_mm", s.search_radius_mm},

@@ -265,6 +265,60 @@ TEST(ImagingSegment, PhantomHeadMatchesTruthAcrossGapsSidesAndSpacings) {
   }
 }
 
+// The phantom's CT cut to a field of view centred (left-right) on its head,
+// `half_width_mm` either side, as a scanner's targeted reconstruction of one hip.
+imaging::Volume centredOnHead(const phantom::Phantom& p, double half_width_mm) {
+  const ImageGeometry& g = p.ct.geometry;
+  const Eigen::Vector3d c = g.toIndex(p.head.center);
+  const int half = static_cast<int>(half_width_mm / g.spacing[0]);
+  const int i0 = std::max(0, static_cast<int>(std::lround(c[0])) - half);
+  const int i1 = std::min(g.size[0] - 1, static_cast<int>(std::lround(c[0])) + half);
+  imaging::Volume out;
+  out.geometry = g;
+  out.geometry.size[0] = i1 - i0 + 1;
+  out.geometry.origin = g.toPhysical(Eigen::Vector3d(i0, 0, 0));
+  out.voxels.resize(static_cast<size_t>(out.geometry.voxelCount()));
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = i0; i <= i1; ++i) out.at(i - i0, j, k) = p.ct.at(i, j, k);
+  return out;
+}
+
+TEST(ImagingSegment, AFieldOfViewCentredOnTheHeadTellsTheSideByTheSocket) {
+  // The field's middle is the head's own x: no side can be read from
+  // positions, and the body's outline is not in the field. The socket,
+  // medial across the joint space, tells it: the head is found on its side
+  // and refused, naming the side it is, on the other.
+  for (const bool right : {true, false}) {
+    phantom::PhantomOptions o;
+    o.seed = 11;
+    o.right = right;
+    o.spacing = Eigen::Vector3d(0.8, 0.8, 1.0);
+    phantom::Phantom p = phantom::makePhantom(o);
+    p.ct = centredOnHead(p, 60);
+    const ImageGeometry& g = p.ct.geometry;
+    EXPECT_NEAR(g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2)[0], p.head.center[0], 1.0);
+    imaging::SegmentOptions so;
+    so.side = right ? imaging::Side::Right : imaging::Side::Left;
+    imaging::SegmentSummary s;
+    const imaging::Label label = imaging::segmentHead(p.ct, so, &s);
+    SCOPED_TRACE(right ? "right" : "left");
+    EXPECT_GT(s.label_voxels, 0.9 * 4.0 / 3.0 * M_PI * p.head.radii.prod() / g.spacing.prod());  // the whole head
+    EXPECT_EQ(label.geometry.size, g.size);
+    EXPECT_NE(s.side_check.find("socket lies medially"), std::string::npos) << s.side_check;
+    EXPECT_LT((s.head_center_mm - p.head.center).norm(), 2.5);
+    imaging::SegmentOptions other = so;
+    other.side = right ? imaging::Side::Left : imaging::Side::Right;
+    try {
+      imaging::segmentHead(p.ct, other);
+      ADD_FAILURE() << "the other side was not refused";
+    } catch (const ProcessingError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("the joint in view is a ") + (right ? "right" : "left")), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(ImagingSegment, SeedPointAndFailures) {
   const phantom::Phantom p = smallPhantom(4);
   imaging::SegmentOptions so;

@@ -1,6 +1,7 @@
 // Head checks: a head's cap passes; each wrong structure fails the check
 // made to reveal it (a socket's inner surface, a small trochanter-like
-// blob, a cut cap, a non-spherical patch, a search that found elsewhere).
+// blob, a cut cap, a non-spherical patch, a search that found elsewhere,
+// a side the search could not tell).
 #include <gtest/gtest.h>
 
 #include "articula/geometry/fibonacci.hpp"
@@ -80,6 +81,17 @@ TEST(HeadQc, ASearchThatFoundAnotherStructureFails) {
   const pipeline::QcReport r = pipeline::checkHead(in);
   EXPECT_EQ(check(r, "search_centre_offset_relative").status, "fail");
   EXPECT_EQ(check(r, "search_radius_difference_relative").status, "fail");
+}
+
+TEST(HeadQc, AnUnverifiedSideWarns) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.side_verified = true;
+  EXPECT_EQ(pipeline::checkHead(in).status, "pass");
+  in.side_verified = false;
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(r.status, "warn");
+  EXPECT_EQ(check(r, "side_verified").status, "warn");
+  EXPECT_NE(check(r, "side_verified").reason.find("side could not be verified"), std::string::npos);
 }
 
 TEST(HeadQc, TooFewPointsAreRefused) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include <itkSmoothingRecursiveGaussianImageFilter.h>
@@ -69,7 +70,12 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
   const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
   HeadCandidate c;
   c.center = start;
-  for (int round = 0; round < 2; ++round) {
+  // Until the rays leave from within half a millimetre of the centre they
+  // find: a start far off the centre (a Hough peak inside the head but near
+  // its edge) finds a small sphere first, and edge distances measured along
+  // rays from elsewhere would not be the head's radius in their direction.
+  for (int round = 0; round < kMaxRayRounds; ++round) {
+    const Eigen::Vector3d ray_origin = c.center;
     std::vector<Eigen::Vector3d> edges(kRayCount, Eigen::Vector3d::Constant(NAN));
     std::vector<double> distances;
     for (int n = 0; n < kRayCount; ++n) {
@@ -111,11 +117,12 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       sse += residual * residual;
       ++used;
       // The edge's distance from the final centre along its ray's direction
-      // (the ray left from the previous centre, a fraction of a mm away).
+      // (the ray left from the previous centre, within half a millimetre).
       c.edge_mm[n] = (edges[n] - sphere.center).dot(geometry::fibonacciDirection(static_cast<int>(n), kRayCount));
     }
     c.coverage = static_cast<double>(used) / kRayCount;
     c.rms_mm = std::sqrt(sse / std::max(used, 1));
+    if (round > 0 && (c.center - ray_origin).norm() <= 0.5) break;
   }
   return c;
 }
@@ -271,7 +278,83 @@ double effectiveMidlineMargin(const ImageGeometry& g, const SegmentOptions& opti
   return hi - lo >= kBothSidesWidthMm ? kAutomaticMidlineMargin : 0.0;
 }
 
+double fieldWidthMm(const ImageGeometry& g) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
+    lo = std::min(lo, g.toPhysical(ijk)[0]);
+    hi = std::max(hi, g.toPhysical(ijk)[0]);
+  }
+  return hi - lo;
+}
+
+// The body's middle, left-right (LPS x), when the field holds the body's
+// outline whole on both sides: air beyond it at the field's left and right
+// edges. The middle of its 1st and 99th percentiles of x (an arm or the
+// table's edge does not move it). None when the body reaches either edge:
+// then the field's own middle says nothing (a field centred on one hip).
+std::optional<double> bodyMidline(const Volume& coarse) {
+  const ImageGeometry& g = coarse.geometry;
+  const double width = fieldWidthMm(g), edge_band = 2.0 * g.spacing.maxCoeff();
+  double lo = INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
+    lo = std::min(lo, g.toPhysical(ijk)[0]);
+  }
+  std::vector<double> body_x;
+  long edge_cells[2] = {0, 0}, edge_body[2] = {0, 0};
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const double x = g.toPhysical(Eigen::Vector3d(i, j, k))[0];
+        const bool body = coarse.at(i, j, k) > kBodyHu;
+        for (int e = 0; e < 2; ++e)
+          if (e == 0 ? x < lo + edge_band : x > lo + width - edge_band) {
+            ++edge_cells[e];
+            edge_body[e] += body;
+          }
+        if (body) body_x.push_back(x);
+      }
+  if (body_x.size() < 100) return std::nullopt;
+  for (int e = 0; e < 2; ++e)
+    if (edge_body[e] > kBodyAtEdgeShare * static_cast<double>(edge_cells[e])) return std::nullopt;
+  const auto at = [&](double q) {
+    const auto n = static_cast<std::ptrdiff_t>(q * static_cast<double>(body_x.size() - 1));
+    std::nth_element(body_x.begin(), body_x.begin() + n, body_x.end());
+    return body_x[static_cast<size_t>(n)];
+  };
+  return 0.5 * (at(0.01) + at(0.99));
+}
+
 }  // namespace
+
+std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head, const SegmentOptions& options) {
+  // Rays from the head's centre: past its edge, a gap (below bone), then
+  // bone within half a radius: the socket, across the joint space. The neck
+  // has no gap and the open cap no bone, so neither counts.
+  int socket = 0;
+  double sum_x = 0;
+  for (int n = 0; n < kRayCount; ++n) {
+    const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
+    bool gap = false, hit = false;
+    for (double t = head.radius + 0.5; t <= 1.5 * head.radius && !hit; t += 0.5) {
+      const double hu = interpolate(volume, head.center + t * u);
+      if (std::isnan(hu)) break;
+      if (hu < options.hu_min) gap = true;
+      else if (gap) hit = true;
+      else if (t > head.radius + kSocketGapSearchMm) break;  // bone past the edge without a gap: neck
+    }
+    if (hit) {
+      ++socket;
+      sum_x += u[0];
+    }
+  }
+  if (socket < kMinSocketRayShare * kRayCount) return std::nullopt;
+  const double mean_x = sum_x / socket;
+  if (std::abs(mean_x) < kMinSocketMedialShift) return std::nullopt;
+  // LPS +x is the patient's left: a socket on the +x side is medial to a right joint.
+  return mean_x > 0 ? Side::Right : Side::Left;
+}
 
 /// Automatic head search: a 3-D Hough transform for spheres on a grid of
 /// about options.search_spacing_mm. Every voxel on the bone's surface votes
@@ -282,7 +365,7 @@ double effectiveMidlineMargin(const ImageGeometry& g, const SegmentOptions& opti
 /// voxels facing them; the strongest on the requested side whose sphere is a
 /// plausible head is the head.
 /// Hand-written: ITK's Hough filters are 2-D only.
-bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head) {
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side) {
   const ImageGeometry& g = volume.geometry;
   Eigen::Vector3i factor;
   for (int a = 0; a < 3; ++a)
@@ -336,8 +419,21 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
       Eigen::Vector3i v;
       if (cellOf(voter.x + t * voter.n, v)) votes[static_cast<size_t>(cg.linear(v[0], v[1], v[2]))] += 1.0f;
     }
-  const double mid_x = g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
-  const double midline_margin = effectiveMidlineMargin(g, options);
+  // The body's middle from its outline; else the field's, when the field is
+  // wide enough to hold both sides; else (one joint in a narrow field) no
+  // side is taken from positions, and the socket tells it below.
+  const bool right = options.side == Side::Right;
+  const std::optional<double> body_mid = bodyMidline(coarse);
+  const bool wide = fieldWidthMm(g) >= kBothSidesWidthMm;
+  const double mid_x = body_mid ? *body_mid : g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
+  const bool side_by_position = body_mid.has_value() || wide;
+  const double midline_margin = side_by_position ? effectiveMidlineMargin(g, options) : 0.0;
+  const auto onSide = [&](const Eigen::Vector3d& x) {
+    return !side_by_position || ((x[0] < mid_x) == right && std::abs(x[0] - mid_x) >= midline_margin);
+  };
+  side.how = body_mid ? "left or right of the body's middle (x = " + std::to_string(*body_mid) + " mm, from its outline)"
+               : wide   ? "left or right of the field of view's middle"
+                        : "";
   struct Peak { Eigen::Vector3d x; double votes; };
   std::vector<Peak> peaks;
   for (int k = 1; k + 1 < cg.size[2]; ++k)
@@ -349,7 +445,7 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
             for (int di = -1; di <= 1; ++di) sum += votes[static_cast<size_t>(cg.linear(i + di, j + dj, k + dk))];
         const Eigen::Vector3d x = cg.toPhysical(Eigen::Vector3d(i, j, k));
         // LPS: +x points to the patient's left; the field of view is centred on the body.
-        if (sum > 0 && (options.side == Side::Right) == (x[0] < mid_x)) peaks.push_back({x, sum});
+        if (sum > 0 && (!side_by_position || right == (x[0] < mid_x))) peaks.push_back({x, sum});
       }
   std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.votes > b.votes; });
   std::vector<Peak> kept;  // strongest first, at least a head radius apart
@@ -375,11 +471,29 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   const HeadCandidate* best = nullptr;
   for (const HeadCandidate& c : candidates) {
     const bool plausible = c.wellMeasured(g.spacing.maxCoeff()) && c.radius >= r_lo && c.radius <= r_hi &&
-                           c.coverage >= options.min_coverage && (c.center[0] < mid_x) == (options.side == Side::Right) &&
-                           std::abs(c.center[0] - mid_x) >= midline_margin && insideVolume(g, c.center);
+                           c.coverage >= options.min_coverage && onSide(c.center) && insideVolume(g, c.center);
     if (plausible && (!best || c.area() > best->area())) best = &c;
   }
+  // In a narrow field without the body's outline, the socket says which
+  // side the joint is: a joint of the other side is refused, not analysed.
+  const auto sideConfirmed = [&](const HeadCandidate& c) {
+    if (side_by_position) return true;
+    const std::optional<Side> by_socket = sideBySocket(volume, c, options);
+    const std::string joint_side = by_socket == Side::Right ? "right" : "left";
+    if (!by_socket) {
+      side.how = "";
+    } else if (*by_socket != options.side) {
+      side.other_side = true;
+      side.how = "the joint in view is a " + joint_side + " one: its socket lies on its " +
+                   (by_socket == Side::Right ? "left (+x)" : "right (-x)") + ", medially";
+      return false;
+    } else {
+      side.how = "its socket lies medially (" + std::string(right ? "+x" : "-x") + "), in a field of view too narrow for both sides";
+    }
+    return true;
+  };
   if (best) {
+    if (!sideConfirmed(*best)) return false;
     head = *best;
     return true;
   }
@@ -392,9 +506,9 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
     HeadCandidate c = sphereOfFacingVoxels(p.x, voters, options, cg.spacing.minCoeff(), cell_area);
     log::debug("head candidate " + vec(p.x) + " mm by facing surface voxels: centre " + vec(c.center) + " mm, radius " +
                std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage));
-    if (c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage &&
-        (c.center[0] < mid_x) == (options.side == Side::Right) && std::abs(c.center[0] - mid_x) >= midline_margin &&
+    if (c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage && onSide(c.center) &&
         insideVolume(g, c.center)) {
+      if (!sideConfirmed(c)) return false;
       head = c;
       return true;
     }

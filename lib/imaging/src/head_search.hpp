@@ -3,6 +3,7 @@
 // for spheres proposes centres, rays cast from each measure the sphere
 // through the first bone edges seen from inside) and cutting the bone
 // beyond the head's edges. Used by segment.cpp.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,17 @@ constexpr double kRmsVoxelShare = 0.25;
 // (hips 70-110 mm, shoulders 120-200 mm; vertebral bodies, near-spherical
 // too, lie on it).
 constexpr double kBothSidesWidthMm = 250, kAutomaticMidlineMargin = 40;
+// The body's outline: above this HU (fat is about -100, air -1000). It is
+// whole left and right when at most this share of the field's edge columns
+// hold body.
+constexpr double kBodyHu = -400, kBodyAtEdgeShare = 0.02;
+// The socket seen from a head's centre: bone past a gap within half a
+// radius of the head's edge, on at least this share of the rays, whose mean
+// direction leans this far to one side (x component); bone that follows the
+// edge without a gap within this distance is the neck.
+constexpr double kMinSocketRayShare = 0.10, kMinSocketMedialShift = 0.2, kSocketGapSearchMm = 6.0;
 constexpr int kRayCount = 512;
+constexpr int kMaxRayRounds = 5;  // rays cast again from each new centre, at most this often
 
 /// A head measured from a point inside it: the sphere through the first bone
 /// edges seen on rays from that point, and the edges themselves.
@@ -46,8 +57,21 @@ bool insideVolume(const ImageGeometry& g, const Eigen::Vector3d& x);
 
 /// Measures the head seen from `start` (a point inside it).
 HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& start, const SegmentOptions& options);
-/// The automatic search on options.side; false when no candidate is a plausible head.
-bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head);
+/// The automatic search on options.side; false when no candidate is a
+/// plausible head, or when the one found is of the other side. The side
+/// comes from the body's middle (its outline, when whole in the field), else
+/// the field's middle (a field wide enough for both sides), else the socket
+/// (sideBySocket, one joint in a narrow field). `side` says how, or why the
+/// head was refused.
+struct SideCheck {
+  std::string how;           // empty: the side could not be verified
+  bool other_side = false;   // the joint found is of the other side: refused
+};
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side);
+/// The side a joint is on from its socket, medial to it across the joint
+/// space (acetabulum, glenoid); none when too little socket is seen or it
+/// leans to neither side.
+std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head, const SegmentOptions& options);
 /// Clears the mask's voxels beyond the head's edges in the directions of its cap.
 void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head);
 

@@ -263,7 +263,13 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     const std::string joint = options.joint == Joint::Hip ? "hip" : "shoulder";
     const std::string side = options.side == Side::Right ? "right" : "left";
     summary.seed_source = "automatic (" + joint + ", " + side + ")";
-    if (!findHead(volume, options, head_found)) {
+    SideCheck side_check;
+    const bool found = findHead(volume, options, head_found, side_check);
+    if (side_check.other_side)
+      throw ProcessingError("no " + std::string(options.joint == Joint::Hip ? "femoral" : "humeral") + " head on the " + side +
+                            " side: " + side_check.how + " (the field of view holds one side only; run with --side " +
+                            (side == "right" ? "left" : "right") + " if that is the joint meant)");
+    if (!found) {
       std::ostringstream m;
       m << "no " << (options.joint == Joint::Hip ? "femoral" : "humeral") << " head found on the " << side
         << " side: no sphere of radius " << options.min_head_radius_mm << "-" << options.max_head_radius_mm
@@ -272,6 +278,10 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
         << " give --seed-point X,Y,Z (LPS mm) or adjust --hu-min";
       throw ProcessingError(m.str());
     }
+    summary.side_check = side_check.how.empty() ? "not verified" : side_check.how;
+    if (side_check.how.empty())
+      summary.warnings.push_back("the " + side + " side could not be verified: the field of view shows neither the body's "
+                                 "outline on both sides nor a socket clearly medial to the head; the joint in view was taken");
     measured = !head_found.edge_mm.empty();
     center = head_found.center;
     depth = head_found.radius;

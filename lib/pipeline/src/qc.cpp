@@ -102,6 +102,17 @@ QcReport checkHead(const HeadQcInput& in) {
       report.checks.push_back(grade("search_radius_difference_relative", std::abs(in.search_radius_mm - r) / r, kRadiusWarn,
                                     kRadiusFail, false, "the head search's radius differs from the fitted one, relative:"));
   }
+  if (in.side_verified) {
+    QcCheck side;
+    side.name = "side_verified";
+    side.value = *in.side_verified ? 1 : 0;
+    side.rule = "warn when neither the body's middle, a field of view holding both sides, nor the socket tells the side";
+    side.status = *in.side_verified ? "pass" : "warn";
+    if (!*in.side_verified)
+      side.reason = "the joint's side could not be verified (a narrow field of view without the body's outline, and no "
+                    "socket clearly medial to the head): the joint in view was taken as the requested side";
+    report.checks.push_back(side);
+  }
   for (const QcCheck& check : report.checks) {
     if (check.status == "fail") report.status = "fail";
     else if (check.status == "warn" && report.status == "pass") report.status = "warn";

@@ -95,6 +95,7 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
         const auto& sc = seg.at("head_center_mm");
         in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());
         in.search_radius_mm = seg.value("search_radius_mm", 0.0);
+        if (seg.contains("side_check")) in.side_verified = seg.value("side_check", "") != "not verified";
       }
     } catch (const json::exception& e) {
       throw InputError("cannot read the segmentation summary '" + segment_summary.string() + "': " + e.what());

@@ -47,6 +47,7 @@ struct SegmentOptions {
 
 struct SegmentSummary {
   std::string seed_source;                  // "seed-point" or "automatic (joint, side)"
+  std::string side_check;                   // automatic: how the side was established, or "not verified"
   Eigen::Vector3d seed_mm = Eigen::Vector3d::Zero();
   // Automatic search: the centre of the head's sphere; with a seed point:
   // the deepest point of the label.

@@ -3,7 +3,8 @@
 // head's radius against plausible heads, the angular extent of the
 // articular cap, the share of point normals pointing away from the head's
 // centre (a socket's inner surface points towards it), the points' spread
-// about their sphere, and the agreement of the head search with the fit.
+// about their sphere, the agreement of the head search with the fit, and
+// whether the search could tell the joint's side.
 // Each check passes, warns (doubtful) or fails (the result is not a head).
 #include <optional>
 #include <string>
@@ -21,6 +22,7 @@ struct HeadQcInput {
   double sphere_radius_mm = 0;
   std::optional<Eigen::Vector3d> search_center;  // the segmentation's head, if it searched
   double search_radius_mm = 0;
+  std::optional<bool> side_verified;             // the search's side check, if it searched
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
 };
 
