@@ -329,22 +329,30 @@ std::optional<double> bodyMidline(const Volume& coarse) {
 }  // namespace
 
 std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head, const SegmentOptions& options) {
-  // Rays from the head's centre: past its edge, a gap (below bone), then
-  // bone within half a radius: the socket, across the joint space. The neck
-  // has no gap and the open cap no bone, so neither counts.
+  // Rays from the head's centre: its cortex falls into the joint space,
+  // which rises again into the socket within half a radius. A fall and a
+  // rise of a contrast each, not a level: a narrow gap's blurred valley
+  // stays above the bone window. The neck does not fall at the head's
+  // edge, and the open cap does not rise again.
   int socket = 0;
   double sum_x = 0;
   for (int n = 0; n < kRayCount; ++n) {
     const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
-    bool gap = false, hit = false;
-    for (double t = head.radius + 0.5; t <= 1.5 * head.radius && !hit; t += 0.5) {
+    double peak = -INFINITY, valley = INFINITY;
+    bool fell = false, rose = false;
+    for (double t = head.radius - 2.0; t <= 1.5 * head.radius && !rose; t += 0.25) {
       const double hu = interpolate(volume, head.center + t * u);
       if (std::isnan(hu)) break;
-      if (hu < options.hu_min) gap = true;
-      else if (gap) hit = true;
-      else if (t > head.radius + kSocketGapSearchMm) break;  // bone past the edge without a gap: neck
+      if (!fell) {
+        peak = std::max(peak, hu);
+        fell = peak - hu >= kSocketContrastHu && t <= head.radius + 2.0;
+        valley = hu;
+      } else {
+        valley = std::min(valley, hu);
+        rose = hu - valley >= kSocketContrastHu && hu >= options.hu_min;
+      }
     }
-    if (hit) {
+    if (rose) {
       ++socket;
       sum_x += u[0];
     }

@@ -28,11 +28,10 @@ constexpr double kBothSidesWidthMm = 250, kAutomaticMidlineMargin = 40;
 // whole left and right when at most this share of the field's edge columns
 // hold body.
 constexpr double kBodyHu = -400, kBodyAtEdgeShare = 0.02;
-// The socket seen from a head's centre: bone past a gap within half a
-// radius of the head's edge, on at least this share of the rays, whose mean
-// direction leans this far to one side (x component); bone that follows the
-// edge without a gap within this distance is the neck.
-constexpr double kMinSocketRayShare = 0.10, kMinSocketMedialShift = 0.2, kSocketGapSearchMm = 6.0;
+// The socket seen from a head's centre: a fall of kSocketContrastHu at the
+// head's edge and a rise of as much within half a radius, on at least this
+// share of the rays, whose mean direction leans this far to one side (x).
+constexpr double kMinSocketRayShare = 0.10, kMinSocketMedialShift = 0.2, kSocketContrastHu = 150;
 constexpr int kRayCount = 512;
 constexpr int kMaxRayRounds = 5;  // rays cast again from each new centre, at most this often
 
