@@ -319,6 +319,37 @@ TEST(ImagingSegment, AFieldOfViewCentredOnTheHeadTellsTheSideByTheSocket) {
   }
 }
 
+TEST(ImagingSegment, ACandidateMeasuredFromNearItsEdgeKeepsTheHeadsRim) {
+  // A small osteoporotic head (seed 11, 0.8 mm voxels) where one Hough peak
+  // lies 17 mm above the centre: its rays find a small sphere first and
+  // reach the head only after several rounds. Measured from where its rays
+  // did not start, its edges sat 2 mm inside the head and the cut took the
+  // head's rim off (points 0.9 mm inside the true surface); a candidate is
+  // now measured only once its centre settles.
+  phantom::PhantomOptions o;
+  o.seed = 11;
+  o.model = geometry::ShapeModel::Sphere;
+  o.spacing = Eigen::Vector3d(0.8, 0.8, 0.8);
+  o.gap_mm = 4.0;
+  o.head_radius_mm = 17.4;
+  o.fovea = true;
+  o.exact_depth = true;
+  o.ras_storage = true;
+  o.makeOsteoporotic();
+  phantom::Phantom p = phantom::makePhantom(o);
+  // As `articula phantom` stores it (NIfTI, int16) and the run reads it.
+  const auto dir = testing::scratch("near-edge");
+  imaging::writeVolume(dir / "ct.nii.gz", p.ct);
+  p.ct = imaging::readVolume(dir / "ct.nii.gz", {});
+  imaging::SegmentSummary s;
+  const imaging::Label label = imaging::segmentHead(p.ct, {}, &s);
+  const HeadCheck h = checkHead(p, label, s);
+  EXPECT_GT(h.head_recall, 0.97);
+  EXPECT_LT(h.socket_leak, 0.01);
+  EXPECT_LT(h.center_error_mm, 1.0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ImagingSegment, SeedPointAndFailures) {
   const phantom::Phantom p = smallPhantom(4);
   imaging::SegmentOptions so;

@@ -70,6 +70,12 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
   const double r_lo = options.min_head_radius_mm, r_hi = options.max_head_radius_mm;
   HeadCandidate c;
   c.center = start;
+  // A candidate whose centre is still moving was measured from elsewhere.
+  const auto unmeasured = [&c]() {
+    c.edge_mm.clear();
+    c.coverage = 0;
+    return c;
+  };
   // Until the rays leave from within half a millimetre of the centre they
   // find: a start far off the centre (a Hough peak inside the head but near
   // its edge) finds a small sphere first, and edge distances measured along
@@ -85,7 +91,7 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       edges[static_cast<size_t>(n)] = c.center + e.offset_mm * u;
       distances.push_back(e.offset_mm);
     }
-    if (distances.size() < 10) return c;
+    if (distances.size() < 10) return unmeasured();
     std::nth_element(distances.begin(), distances.begin() + static_cast<long>(distances.size() / 2), distances.end());
     geometry::Sphere sphere{c.center, distances[distances.size() / 2]};
     const double voxel = volume.geometry.spacing.maxCoeff();
@@ -97,13 +103,13 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
         inlier[n] = !std::isnan(edges[n][0]) && std::abs((edges[n] - sphere.center).norm() - sphere.radius) <= band;
         if (inlier[n]) kept.push_back(edges[n]);
       }
-      if (kept.size() < 10) return c;
+      if (kept.size() < 10) return unmeasured();
       Eigen::MatrixX3d points(static_cast<Eigen::Index>(kept.size()), 3);
       for (size_t i = 0; i < kept.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = kept[i].transpose();
       try {
         sphere = geometry::fitSphere(points);
       } catch (const ProcessingError&) {
-        return c;  // degenerate support (a flat or tiny patch): no head here
+        return unmeasured();  // degenerate support (a flat or tiny patch): no head here
       }
     }
     c.center = sphere.center;
@@ -122,9 +128,9 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
     }
     c.coverage = static_cast<double>(used) / kRayCount;
     c.rms_mm = std::sqrt(sse / std::max(used, 1));
-    if (round > 0 && (c.center - ray_origin).norm() <= 0.5) break;
+    if (round > 0 && (c.center - ray_origin).norm() <= 0.5) return c;
   }
-  return c;
+  return unmeasured();
 }
 
 namespace {
@@ -264,28 +270,27 @@ void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head) {
 
 namespace {
 
-/// The margin about the field of view's middle (left-right) that no head
-/// lies in: as given, or automatic (options.midline_margin_mm < 0).
-double effectiveMidlineMargin(const ImageGeometry& g, const SegmentOptions& options) {
-  if (options.midline_margin_mm >= 0) return options.midline_margin_mm;
-  double lo = INFINITY, hi = -INFINITY;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
-    const double x = g.toPhysical(ijk)[0];
-    lo = std::min(lo, x);
-    hi = std::max(hi, x);
-  }
-  return hi - lo >= kBothSidesWidthMm ? kAutomaticMidlineMargin : 0.0;
-}
-
-double fieldWidthMm(const ImageGeometry& g) {
+// The field of view's extent left-right (LPS x) over its corners.
+std::pair<double, double> fieldXRange(const ImageGeometry& g) {
   double lo = INFINITY, hi = -INFINITY;
   for (int corner = 0; corner < 8; ++corner) {
     const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
     lo = std::min(lo, g.toPhysical(ijk)[0]);
     hi = std::max(hi, g.toPhysical(ijk)[0]);
   }
+  return {lo, hi};
+}
+
+double fieldWidthMm(const ImageGeometry& g) {
+  const auto [lo, hi] = fieldXRange(g);
   return hi - lo;
+}
+
+/// The margin about the field of view's middle (left-right) that no head
+/// lies in: as given, or automatic (options.midline_margin_mm < 0).
+double effectiveMidlineMargin(const ImageGeometry& g, const SegmentOptions& options) {
+  if (options.midline_margin_mm >= 0) return options.midline_margin_mm;
+  return fieldWidthMm(g) >= kBothSidesWidthMm ? kAutomaticMidlineMargin : 0.0;
 }
 
 // The body's middle, left-right (LPS x), when the field holds the body's
@@ -295,12 +300,8 @@ double fieldWidthMm(const ImageGeometry& g) {
 // then the field's own middle says nothing (a field centred on one hip).
 std::optional<double> bodyMidline(const Volume& coarse) {
   const ImageGeometry& g = coarse.geometry;
-  const double width = fieldWidthMm(g), edge_band = 2.0 * g.spacing.maxCoeff();
-  double lo = INFINITY;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d ijk((corner & 1) ? g.size[0] - 1 : 0, (corner & 2) ? g.size[1] - 1 : 0, (corner & 4) ? g.size[2] - 1 : 0);
-    lo = std::min(lo, g.toPhysical(ijk)[0]);
-  }
+  const auto [lo, hi] = fieldXRange(g);
+  const double edge_band = 2.0 * g.spacing.maxCoeff();
   std::vector<double> body_x;
   long edge_cells[2] = {0, 0}, edge_body[2] = {0, 0};
   for (int k = 0; k < g.size[2]; ++k)
@@ -309,7 +310,7 @@ std::optional<double> bodyMidline(const Volume& coarse) {
         const double x = g.toPhysical(Eigen::Vector3d(i, j, k))[0];
         const bool body = coarse.at(i, j, k) > kBodyHu;
         for (int e = 0; e < 2; ++e)
-          if (e == 0 ? x < lo + edge_band : x > lo + width - edge_band) {
+          if (e == 0 ? x < lo + edge_band : x > hi - edge_band) {
             ++edge_cells[e];
             edge_body[e] += body;
           }

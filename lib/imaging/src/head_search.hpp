@@ -33,7 +33,9 @@ constexpr double kBodyHu = -400, kBodyAtEdgeShare = 0.02;
 // share of the rays, whose mean direction leans this far to one side (x).
 constexpr double kMinSocketRayShare = 0.10, kMinSocketMedialShift = 0.2, kSocketContrastHu = 150;
 constexpr int kRayCount = 512;
-constexpr int kMaxRayRounds = 5;  // rays cast again from each new centre, at most this often
+// Rays are cast again from each new centre, at most this often; a candidate
+// whose centre still moves is not measured.
+constexpr int kMaxRayRounds = 8;
 
 /// A head measured from a point inside it: the sphere through the first bone
 /// edges seen on rays from that point, and the edges themselves.

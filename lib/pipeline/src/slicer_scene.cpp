@@ -82,20 +82,25 @@ std::string slicerSceneXml(const SlicerSceneContent& content) {
   std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<MRML version=\"Slicer 5.0.0 1\" userTags=\"\">\n" +
                     colourTable(colour_node);
   int index = 1;
-  if (content.bone) xml += modelNodes({"bone", "bone.vtp", "0.89 0.84 0.72", 0.6}, index++);
+  const auto plain = [](const std::string& name, const std::string& file, const std::string& colour, double opacity) {
+    ModelNode m;
+    m.name = name, m.file = file, m.colour = colour, m.opacity = opacity;
+    return m;
+  };
+  if (content.bone) xml += modelNodes(plain("bone", "bone.vtp", "0.89 0.84 0.72", 0.6), index++);
   static const std::array<const char*, 6> palette = {"0.30 0.69 0.29", "1 0.5 0", "0.6 0.31 0.64",
                                                      "0.65 0.34 0.16", "0.91 0.16 0.54", "0.6 0.6 0.6"};
   for (size_t i = 0; i < content.models.size(); ++i) {
     const std::string& model = content.models[i];
     const auto range = content.colour_range_mm.find(model);
-    ModelNode points{model + " points", "errors/points_" + model + ".vtp"};
+    ModelNode points = plain(model + " points", "errors/points_" + model + ".vtp", "0.9 0.9 0.3", 1.0);
     points.visible = model == content.selected_model;
     points.points = true;
     points.scalar_name = "signed_distance_mm";
     points.colour_node = colour_node;
     points.range = range == content.colour_range_mm.end() ? 1.0 : range->second;
     xml += modelNodes(points, index++);
-    ModelNode surface{model + " fitted", "errors/surface_" + model + ".ply", palette[i % palette.size()], 0.4};
+    ModelNode surface = plain(model + " fitted", "errors/surface_" + model + ".ply", palette[i % palette.size()], 0.4);
     surface.visible = false;
     xml += modelNodes(surface, index++);
   }
