@@ -13,6 +13,8 @@ PACKAGES=(
   libsimbody-dev libfcl-dev libccd-dev libbullet-dev
   # the reports' inlined 3-D view; the browser and schema checks of the tests
   libjs-three chromium python3-jsonschema
+  # the independent hip phantoms of bench/independent_phantoms.sh
+  python3-numpy python3-scipy
   # studies that outgrow one machine (pipelines/Snakefile)
   snakemake
   # fuzzing the readers (scripts/fuzz.sh): Clang and its libFuzzer runtime

@@ -94,6 +94,27 @@ TEST(HeadQc, AnUnverifiedSideWarns) {
   EXPECT_NE(check(r, "side_verified").reason.find("side could not be verified"), std::string::npos);
 }
 
+TEST(HeadQc, TwoDoubtsTogetherFail) {
+  // A search centre 0.2 radii away warns; so does a spread of 5 % of the
+  // radius about the sphere; together they fail. An unverified side does
+  // not count as a doubt about the structure.
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.search_center = in.sphere_center + Eigen::Vector3d(0, 0.2 * 23, 0);
+  in.search_radius_mm = 23;
+  EXPECT_EQ(pipeline::checkHead(in).status, "warn");
+  in.side_verified = false;
+  EXPECT_EQ(pipeline::checkHead(in).status, "warn");
+  for (Eigen::Index i = 0; i < in.points.rows(); ++i) {
+    const Eigen::Vector3d u = (in.points.row(i).transpose() - in.sphere_center).normalized();
+    in.points.row(i) += (0.05 * 23 * (i % 2 ? 1.0 : -1.0) * u).transpose();
+  }
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "sphere_rms_relative").status, "warn");
+  EXPECT_EQ(check(r, "doubtful_checks").status, "fail");
+  EXPECT_EQ(check(r, "doubtful_checks").value, 2);
+  EXPECT_EQ(r.status, "fail");
+}
+
 TEST(HeadQc, TooFewPointsAreRefused) {
   pipeline::HeadQcInput in = cap(23, 85);
   in.points.conservativeResize(3, 3);

@@ -477,11 +477,22 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   // The plausible head with the largest spherical bone surface: a trochanter
   // or a tuberosity is smaller and less spherical, the outer surface of a
   // socket is never the first edge seen from the centre.
+  const auto plausible = [&](const HeadCandidate& c) {
+    return c.wellMeasured(g.spacing.maxCoeff()) && c.radius >= r_lo && c.radius <= r_hi &&
+           c.coverage >= options.min_coverage && onSide(c.center) && insideVolume(g, c.center);
+  };
   const HeadCandidate* best = nullptr;
-  for (const HeadCandidate& c : candidates) {
-    const bool plausible = c.wellMeasured(g.spacing.maxCoeff()) && c.radius >= r_lo && c.radius <= r_hi &&
-                           c.coverage >= options.min_coverage && onSide(c.center) && insideVolume(g, c.center);
-    if (plausible && (!best || c.area() > best->area())) best = &c;
+  for (const HeadCandidate& c : candidates)
+    if (plausible(c) && (!best || c.area() > best->area())) best = &c;
+  // Candidates about the same place are two spheres through one structure's
+  // edges: the one that fits them better is its shape (with coarse voxels a
+  // sphere through part of a head and its socket can span more area).
+  if (best) {
+    const HeadCandidate* largest = best;
+    for (const HeadCandidate& c : candidates)
+      if (plausible(c) && (c.center - largest->center).norm() < 0.5 * largest->radius &&
+          c.rms_mm / c.radius < best->rms_mm / best->radius)
+        best = &c;
   }
   // In a narrow field without the body's outline, the socket says which
   // side the joint is: a joint of the other side is refused, not analysed.

@@ -18,6 +18,7 @@ constexpr double kOutwardFail = 0.90, kOutwardWarn = 0.97;
 constexpr double kRmsWarn = 0.04, kRmsFail = 0.08;            // of the radius
 constexpr double kCentreWarn = 0.15, kCentreFail = 0.30;      // search vs fit, of the radius
 constexpr double kRadiusWarn = 0.15, kRadiusFail = 0.30;      // relative difference
+constexpr int kDoubtsThatFail = 2;                              // warnings of the structure's checks
 
 std::string number(double v) {
   std::ostringstream s;
@@ -112,6 +113,21 @@ QcReport checkHead(const HeadQcInput& in) {
       side.reason = "the joint's side could not be verified (a narrow field of view without the body's outline, and no "
                     "socket clearly medial to the head): the joint in view was taken as the requested side";
     report.checks.push_back(side);
+  }
+  // Doubts compound: two checks of the structure that each find the head
+  // doubtful are two independent signs of a wrong structure (on the phantom matrix, the one
+  // head with two warnings had taken part of its socket; no correct head
+  // had more than one).
+  int doubts = 0;
+  for (const QcCheck& check : report.checks) doubts += check.status == "warn" && check.name != "side_verified";
+  if (doubts >= kDoubtsThatFail) {
+    QcCheck together;
+    together.name = "doubtful_checks";
+    together.value = doubts;
+    together.rule = "fail at " + std::to_string(kDoubtsThatFail) + " or more warnings";
+    together.status = "fail";
+    together.reason = std::to_string(doubts) + " checks find the head doubtful at once";
+    report.checks.push_back(together);
   }
   for (const QcCheck& check : report.checks) {
     if (check.status == "fail") report.status = "fail";
