@@ -69,6 +69,14 @@ bool determinedByPoints(geometry::ShapeModel model, const json& not_identifiable
   return true;
 }
 
+// The half widths through the centre along the local axes: an ovoid's a
+// and b are scaled by c0x and c0y, and only the products are its shape.
+Eigen::Vector3d semiAxes(const geometry::ShapeParameters& shape) {
+  if (shape.model == geometry::ShapeModel::Sphere) return Eigen::Vector3d::Constant(shape.radii[0]);
+  const bool ovoid = shape.model == geometry::ShapeModel::Ovoid || shape.model == geometry::ShapeModel::Superovoid;
+  return {shape.radii[0] * (ovoid ? shape.cx[0] : 1.0), shape.radii[1] * (ovoid ? shape.cy[0] : 1.0), shape.radii[2]};
+}
+
 json readStageJson(const fs::path& path) {
   if (!fs::exists(path))
     throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
@@ -163,12 +171,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     const int n = errors.value("n_points", 0);
     const double sse = errors.value("sse_mm2", 0.0);
     json entry = {{"model", name}, {"n_parameters", k}, {"parameters", parameters}, {"errors", errors}};
-    // The half widths through the centre along the local axes: an ovoid's
-    // a and b are scaled by c0x and c0y, and only the products are its shape.
-    const bool ovoid = shape.model == geometry::ShapeModel::Ovoid || shape.model == geometry::ShapeModel::Superovoid;
-    const double rb = shape.model == geometry::ShapeModel::Sphere ? shape.radii[0] : shape.radii[1];
-    const double rc = shape.model == geometry::ShapeModel::Sphere ? shape.radii[0] : shape.radii[2];
-    entry["semi_axes_mm"] = {shape.radii[0] * (ovoid ? shape.cx[0] : 1.0), rb * (ovoid ? shape.cy[0] : 1.0), rc};
+    const Eigen::Vector3d semi = semiAxes(shape);
+    entry["semi_axes_mm"] = {semi[0], semi[1], semi[2]};
     // Standard errors in the parameters' units (angles in degrees); null:
     // not identifiable from these points (fits.json, fit/uncertainty.hpp).
     if (fit_entry.contains("standard_errors_table_3_2")) {
@@ -223,7 +227,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   std::vector<LandmarkLine> axes;
   const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
   for (int i = 0; i < 3; ++i)
-    axes.push_back({axis_names[i], c - best_shape.radii[i] * R.col(i), c + best_shape.radii[i] * R.col(i)});
+    axes.push_back({axis_names[i], c - semiAxes(best_shape)[i] * R.col(i), c + semiAxes(best_shape)[i] * R.col(i)});
   writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
   SlicerSceneContent scene;
   scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
