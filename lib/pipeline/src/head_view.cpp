@@ -48,43 +48,41 @@ double cell(const CsvTable& table, size_t row, int column, const fs::path& path)
 
 report::View3d loadHeadView(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
                             const std::string& selected_model) {
-  {
-    report::View3d view;
-    view.selected_model = selected_model;
-    for (const auto& shape : shapes)
-      if (geometry::modelName(shape.model) == selected_model) {
-        view.centre = shape.center;
-        view.radius_mm = shape.radii.maxCoeff();
-      }
-    if (fs::exists(folder / "bone.vtp"))
-      view.bone = boneNear(points::readMeshFile(folder / "bone.vtp"), view.centre, 2.5 * view.radius_mm);
-
-    const fs::path errors_csv = folder / "errors" / "errors.csv";
-    if (!fs::exists(errors_csv)) throw InputError("'" + errors_csv.string() + "' is missing");
-    const CsvTable table = readCsv(errors_csv);
-    const int x = table.column("x_mm"), y = table.column("y_mm"), z = table.column("z_mm");
-    if (x < 0 || y < 0 || z < 0) throw InputError("'" + errors_csv.string() + "' has no x_mm, y_mm, z_mm columns");
-    const auto n = static_cast<Eigen::Index>(table.rows.size());
-    view.points.resize(n, 3);
-    for (Eigen::Index i = 0; i < n; ++i)
-      view.points.row(i) << cell(table, static_cast<size_t>(i), x, errors_csv), cell(table, static_cast<size_t>(i), y, errors_csv),
-          cell(table, static_cast<size_t>(i), z, errors_csv);
-    for (const auto& shape : shapes) {
-      const std::string model = geometry::modelName(shape.model);
-      const int column = table.column("d_" + model + "_mm");
-      if (column >= 0) {
-        report::ViewModelDistances d{model, Eigen::VectorXd(n)};
-        for (Eigen::Index i = 0; i < n; ++i) d.signed_distance_mm[i] = cell(table, static_cast<size_t>(i), column, errors_csv);
-        view.distances.push_back(std::move(d));
-      }
-      const fs::path surface = folder / "errors" / ("surface_" + model + ".ply");
-      if (fs::exists(surface)) {
-        const points::MeshFile m = points::readMeshFile(surface);
-        view.fitted.push_back({model, m.vertices, m.triangles});
-      }
+  report::View3d view;
+  view.selected_model = selected_model;
+  for (const auto& shape : shapes)
+    if (geometry::modelName(shape.model) == selected_model) {
+      view.centre = shape.center;
+      view.radius_mm = shape.radii.maxCoeff();
     }
-    return view;
+  if (fs::exists(folder / "bone.vtp"))
+    view.bone = boneNear(points::readMeshFile(folder / "bone.vtp"), view.centre, 2.5 * view.radius_mm);
+
+  const fs::path errors_csv = folder / "errors" / "errors.csv";
+  if (!fs::exists(errors_csv)) throw InputError("'" + errors_csv.string() + "' is missing");
+  const CsvTable table = readCsv(errors_csv);
+  const int x = table.column("x_mm"), y = table.column("y_mm"), z = table.column("z_mm");
+  if (x < 0 || y < 0 || z < 0) throw InputError("'" + errors_csv.string() + "' has no x_mm, y_mm, z_mm columns");
+  const auto n = static_cast<Eigen::Index>(table.rows.size());
+  view.points.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i)
+    view.points.row(i) << cell(table, static_cast<size_t>(i), x, errors_csv), cell(table, static_cast<size_t>(i), y, errors_csv),
+        cell(table, static_cast<size_t>(i), z, errors_csv);
+  for (const auto& shape : shapes) {
+    const std::string model = geometry::modelName(shape.model);
+    const int column = table.column("d_" + model + "_mm");
+    if (column >= 0) {
+      report::ViewModelDistances d{model, Eigen::VectorXd(n)};
+      for (Eigen::Index i = 0; i < n; ++i) d.signed_distance_mm[i] = cell(table, static_cast<size_t>(i), column, errors_csv);
+      view.distances.push_back(std::move(d));
+    }
+    const fs::path surface = folder / "errors" / ("surface_" + model + ".ply");
+    if (fs::exists(surface)) {
+      const points::MeshFile m = points::readMeshFile(surface);
+      view.fitted.push_back({model, m.vertices, m.triangles});
+    }
   }
+  return view;
 }
 
 }  // namespace articula::pipeline
