@@ -477,10 +477,13 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   // The plausible head with the largest spherical bone surface: a trochanter
   // or a tuberosity is smaller and less spherical, the outer surface of a
   // socket is never the first edge seen from the centre.
-  const auto plausible = [&](const HeadCandidate& c) {
-    return c.wellMeasured(g.spacing.maxCoeff()) && c.radius >= r_lo && c.radius <= r_hi &&
-           c.coverage >= options.min_coverage && onSide(c.center) && insideVolume(g, c.center);
+  // A head's size and share of bone surface, on the side, in the volume;
+  // measured by rays, its edges must also make a sphere.
+  const auto plausibleSphere = [&](const HeadCandidate& c) {
+    return c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage && onSide(c.center) &&
+           insideVolume(g, c.center);
   };
+  const auto plausible = [&](const HeadCandidate& c) { return c.wellMeasured(g.spacing.maxCoeff()) && plausibleSphere(c); };
   const HeadCandidate* best = nullptr;
   for (const HeadCandidate& c : candidates)
     if (plausible(c) && (!best || c.area() > best->area())) best = &c;
@@ -526,8 +529,7 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
     HeadCandidate c = sphereOfFacingVoxels(p.x, voters, options, cg.spacing.minCoeff(), cell_area);
     log::debug("head candidate " + vec(p.x) + " mm by facing surface voxels: centre " + vec(c.center) + " mm, radius " +
                std::to_string(c.radius) + " mm, coverage " + std::to_string(c.coverage));
-    if (c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage && onSide(c.center) &&
-        insideVolume(g, c.center)) {
+    if (plausibleSphere(c)) {
       if (!sideConfirmed(c)) return false;
       head = c;
       return true;

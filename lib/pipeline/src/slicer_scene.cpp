@@ -24,9 +24,9 @@ std::string number(double v) {
 std::string colourTable(const std::string& id) {
   std::string colours;
   for (int i = 0; i < 256; ++i) {
-    const std::string hex = report::divergingColour(-1.0 + 2.0 * i / 255.0);
+    const std::array<std::uint8_t, 3> rgb = report::divergingRgb(-1.0 + 2.0 * i / 255.0);
     colours += (i ? " " : "") + std::to_string(i) + " d" + std::to_string(i);
-    for (int k = 0; k < 3; ++k) colours += " " + number(std::stoi(hex.substr(1 + 2 * static_cast<size_t>(k), 2), nullptr, 16) / 255.0);
+    for (const std::uint8_t c : rgb) colours += " " + number(c / 255.0);
     colours += " 1";
   }
   return " <ColorTable id=\"" + id + "\" name=\"articula signed distance (red inside, blue outside)\" type=\"13\" "

@@ -44,18 +44,12 @@ json surfaceJson(const ViewSurface& surface, const Eigen::Vector3d& centre) {
           {"indices", packed(indices)}};
 }
 
-std::array<std::uint8_t, 3> rgb(const std::string& hex) {
-  std::array<std::uint8_t, 3> c{};
-  for (size_t k = 0; k < 3; ++k) c[k] = static_cast<std::uint8_t>(std::stoi(hex.substr(1 + 2 * k, 2), nullptr, 16));
-  return c;
-}
-
 json colouringJson(const ViewModelDistances& d) {
   const double range = symmetricColourRange(d.signed_distance_mm);
   std::vector<std::uint8_t> colours;
   colours.reserve(static_cast<size_t>(d.signed_distance_mm.size()) * 3);
   for (Eigen::Index i = 0; i < d.signed_distance_mm.size(); ++i)
-    for (const std::uint8_t c : rgb(divergingColour(d.signed_distance_mm[i] / range))) colours.push_back(c);
+    for (const std::uint8_t c : divergingRgb(d.signed_distance_mm[i] / range)) colours.push_back(c);
   return {{"model", d.model}, {"range_mm", range}, {"colours", packed(colours)}};
 }
 

@@ -1,5 +1,7 @@
 #pragma once
 // The diverging colour scale of the error maps.
+#include <array>
+#include <cstdint>
 #include <string>
 
 namespace articula::report {
@@ -10,5 +12,7 @@ namespace articula::report {
 /// through the five stops of ColorBrewer's RdBu, with a grey middle so that
 /// points near 0 stay visible on white.
 std::string divergingColour(double t);
+/// The same colour as red, green, blue bytes (for vertex colours and colour tables).
+std::array<std::uint8_t, 3> divergingRgb(double t);
 
 }  // namespace articula::report
