@@ -37,6 +37,17 @@ class MeshCommand : public cli::Command {
                    "With --ct: edge search either side of a vertex, mm (0: 1.5 voxels, at least 1.5 mm)")
         ->check(CLI::Range(0.0, 10.0))
         ->capture_default_str();
+    app.add_option("--edge-model", edge_model_,
+                   "With --ct: 'cortex' places each edge on the outer surface of a blurred-cortex model fitted to the "
+                   "voxels about the normal (a thin cortex does not pull it outwards); 'steepest' keeps the steepest "
+                   "fall")
+        ->check(CLI::IsMember({"cortex", "steepest"}))
+        ->capture_default_str();
+    app.add_option("--point-spread", snap_.point_spread_mm,
+                   "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation), mm "
+                   "(0: estimated from the CT's edges)")
+        ->check(CLI::Range(0.0, 3.0))
+        ->capture_default_str();
   }
   int run(const cli::CommonOptions& common) override {
     imaging::limitImagingThreads(common.threadCount());
@@ -50,6 +61,7 @@ class MeshCommand : public cli::Command {
       throw UsageError("--output: expected a .vtp, .stl or .ply file, found '" + output_.string() + "'");
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
+    snap_.cortex_model = edge_model_ == "cortex";
     snap_.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
     checkOutputTarget(output_);
@@ -69,7 +81,16 @@ class MeshCommand : public cli::Command {
                {"vertices_on_edge", snapped.on_edge},
                {"share_on_edge", share},
                {"mean_shift_mm", snapped.mean_shift_mm},
-               {"mean_abs_shift_mm", snapped.mean_abs_shift_mm}};
+               {"mean_abs_shift_mm", snapped.mean_abs_shift_mm},
+               {"edge_model", snapped.cortex_model ? "cortex" : "steepest"},
+               {"point_spread_mm", snapped.point_spread_mm},
+               {"point_spread_estimated", snapped.point_spread_estimated},
+               {"vertices_on_cortex_model", snapped.on_cortex_model},
+               {"mean_model_shift_mm", snapped.mean_model_shift_mm}};
+      if (!snapped.cortex_model_note.empty()) {
+        edges["cortex_model_note"] = snapped.cortex_model_note;
+        log::warn("mesh: " + snapped.cortex_model_note);
+      }
       if (snapped.moved)
         log::info("mesh: " + std::to_string(snapped.on_edge) + " of " + std::to_string(snapped.vertices) +
                   " vertices on the CT's edge (mean shift " + std::to_string(snapped.mean_shift_mm) + " mm)");
@@ -83,7 +104,8 @@ class MeshCommand : public cli::Command {
     nlohmann::json params = {{"smoothing", smoothing_}, {"smooth_iterations", options_.smooth_iterations},
                              {"relaxation", options_.relaxation}, {"passband", options_.passband},
                              {"decimate", options_.decimate}, {"largest_component", options_.largest_component},
-                             {"edge_search_mm", snap_.search_mm}};
+                             {"edge_search_mm", snap_.search_mm}, {"edge_model", edge_model_},
+                             {"point_spread_mm", snap_.point_spread_mm}};
     nlohmann::json summary = {{"input", input_.string()},       {"output", output_.string()},
                               {"label_voxels", s.label_voxels}, {"raw_triangles", s.raw_triangles},
                               {"triangles", s.triangles},       {"vertices", s.vertices},
@@ -99,7 +121,7 @@ class MeshCommand : public cli::Command {
 
  private:
   std::filesystem::path input_, output_, ct_;
-  std::string smoothing_ = "laplacian", series_uid_;
+  std::string smoothing_ = "laplacian", series_uid_, edge_model_ = "cortex";
   mesh::EdgeSnapOptions snap_;
   bool all_components_ = false;
   mesh::MeshOptions options_;

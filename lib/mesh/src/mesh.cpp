@@ -28,6 +28,8 @@
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/parallel.hpp"
+#include "articula/imaging/cortex_edge.hpp"
 #include "articula/imaging/edges.hpp"
 #include "articula/points/mesh_file.hpp"
 #include "articula/points/vtk_mesh.hpp"
@@ -214,7 +216,60 @@ void EdgeSnapOptions::validate() const {
   if (!(search_mm >= 0 && search_mm <= 10)) throw UsageError("edge search: expected 0 to 10 mm, found " + std::to_string(search_mm));
   if (!(min_contrast_hu > 0)) throw UsageError("edge contrast must be > 0 HU");
   if (smoothing_passes < 0 || smoothing_passes > 100) throw UsageError("edge smoothing passes: expected 0 to 100");
+  if (!(point_spread_mm >= 0 && point_spread_mm <= 3))
+    throw UsageError("point-spread: expected 0 (estimate) to 3 mm, found " + std::to_string(point_spread_mm));
 }
+
+namespace {
+
+/// Moves the found steepest falls (`shift` along the normals) onto the
+/// outer surface of the blurred-cortex model, with one point-spread for the
+/// whole CT (given, or estimated on up to 300 of the found edges spread over
+/// the surface). A vertex whose model does not fit keeps its steepest fall.
+void placeOnCortexModel(const TriangleMesh& mesh, const imaging::Volume& ct, const std::vector<char>& found,
+                        std::vector<double>& shift, const EdgeSnapOptions& options, EdgeSnapSummary& s) {
+  constexpr size_t kPointSpreadLines = 300;
+  const double radius = imaging::lineRadiusFor(ct.geometry);
+  const auto lineAt = [&](Eigen::Index v) {
+    const Eigen::Vector3d n = mesh.normals.row(v).transpose();
+    const Eigen::Vector3d x = mesh.vertices.row(v).transpose() + shift[static_cast<size_t>(v)] * n;
+    return imaging::voxelsAboutLine(ct, x, n, -imaging::kCortexInwardMm, imaging::kCortexOutwardMm, radius);
+  };
+  std::vector<Eigen::Index> on_edge;
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+    if (found[static_cast<size_t>(v)]) on_edge.push_back(v);
+  double sigma = options.point_spread_mm;
+  if (sigma <= 0) {
+    std::vector<imaging::LineVoxels> lines;
+    const size_t stride = std::max<size_t>(1, on_edge.size() / kPointSpreadLines);
+    for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i]));
+    const imaging::PointSpread ps = imaging::estimatePointSpread(lines, std::vector<double>(lines.size(), 0.0));
+    if (!ps.found) {
+      s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(ps.profiles) +
+                            " edges; the edges are the steepest falls";
+      return;
+    }
+    sigma = ps.sigma_mm;
+    s.point_spread_estimated = true;
+  }
+  s.point_spread_mm = sigma;
+  std::vector<imaging::CortexFit> fits(on_edge.size());
+  parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
+      fits[i] = imaging::fitCortex(lineAt(on_edge[i]), 0.0, sigma, options.min_contrast_hu);
+  });
+  double moved = 0;
+  for (size_t i = 0; i < on_edge.size(); ++i) {
+    if (!fits[i].found) continue;
+    shift[static_cast<size_t>(on_edge[i])] += fits[i].offset_mm;
+    moved += fits[i].offset_mm;
+    ++s.on_cortex_model;
+  }
+  s.cortex_model = true;
+  s.mean_model_shift_mm = s.on_cortex_model ? moved / static_cast<double>(s.on_cortex_model) : 0.0;
+}
+
+}  // namespace
 
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary) {
@@ -248,6 +303,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     if (summary) *summary = s;
     return;
   }
+  if (options.cortex_model) placeOnCortexModel(mesh, ct, found, shift, options, s);
   // Neighbour averages over the triangles' edges: the found shifts smoothed,
   // the others taken from found neighbours (repeatedly, as far as the passes reach).
   std::vector<std::vector<int>> neighbours(static_cast<size_t>(n));

@@ -48,6 +48,13 @@ struct EdgeSnapOptions {
   double min_contrast_hu = 150; // least fall across an edge (see imaging/edges.hpp)
   double min_inside_hu = 200;   // the bone side of an edge reaches at least this
   int smoothing_passes = 2;     // neighbour averages of the shifts (CT noise)
+  /// Each steepest fall moved onto the outer surface of a blurred-cortex
+  /// model fitted to the voxels about the normal (imaging/cortex_edge.hpp),
+  /// which a thin cortex does not pull outwards. Off: the steepest fall.
+  bool cortex_model = true;
+  /// The scanner's Gaussian point-spread for the model, mm (0: estimated
+  /// from the CT's own edges).
+  double point_spread_mm = 0;
   /// Throws UsageError naming the first invalid option.
   void validate() const;
 };
@@ -57,10 +64,20 @@ struct EdgeSnapSummary {
   bool moved = false;                   // false: too few edges, the surface is the label's
   double mean_shift_mm = 0;             // mean signed shift along the outward normal
   double mean_abs_shift_mm = 0;
+  /// The blurred-cortex model: whether it placed the edges, the point-spread
+  /// it used (estimated or given; 0 when none), the vertices it placed and
+  /// their mean shift from the steepest fall (negative: inwards).
+  bool cortex_model = false;
+  double point_spread_mm = 0;
+  bool point_spread_estimated = false;
+  long long on_cortex_model = 0;
+  double mean_model_shift_mm = 0;
+  std::string cortex_model_note;  // why the model was not used, when it was asked for
 };
 
 /// Moves every vertex along its normal onto the CT's bone edge (the
-/// steepest HU fall, imaging::locateEdge), so that the surface lies where
+/// steepest HU fall, imaging::locateEdge, then the outer surface of the
+/// blurred-cortex model where it fits), so that the surface lies where
 /// the cortex meets soft tissue at sub-voxel precision and not where the
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours.

@@ -1,0 +1,71 @@
+#pragma once
+// Where a bone's outer surface is when its cortex is thin: a model of the
+// blurred cortex fitted to the CT's voxels about a line across the edge.
+//
+// The steepest fall of a blurred profile (edges.hpp) lies on the surface of
+// a thick cortex only; a cortex thinner than about three point-spread widths
+// moves it outwards (0.2 mm for 0.8 mm of cortex under 0.5 mm of blur),
+// because the cortex's inner rise adds slope. The model here is the profile
+// itself: soft tissue, cortex and cancellous bone (and, across a joint gap,
+// the socket) as steps, each blurred by the scanner's point-spread and the
+// voxel's own extent along the line, fitted to the voxel values about the
+// line (not to an interpolated profile, whose linear interpolation would be
+// a second, phase-dependent kernel). A thin cortex trades its thickness
+// against the blur within one profile, so the scanner's point-spread is
+// estimated once over many profiles of the same CT (estimatePointSpread)
+// and then held fixed for every line.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "articula/imaging/image.hpp"
+
+namespace articula::imaging {
+
+/// The voxels whose centres lie within `radius_mm` of the line x + s u,
+/// s in [from_mm, to_mm] (u a unit vector pointing out of the bone): their
+/// offsets s along the line and their values.
+struct LineVoxels {
+  std::vector<double> offset_mm, value_hu;
+  double box_variance_mm2 = 0;  // the voxel's extent along u, as a variance (partial volume)
+};
+LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
+                           double to_mm, double radius_mm);
+
+/// The window the model is fitted over: from kCortexInwardMm inside an edge
+/// (the cortex and some cancellous bone) to kCortexOutwardMm outside it (the
+/// joint gap and the near side of a socket).
+constexpr double kCortexInwardMm = 3.5, kCortexOutwardMm = 2.5;
+/// The radius about the line that holds about 50 voxels of the window (at
+/// least 0.8 mm): enough for the model's seven unknowns at any voxel size.
+double lineRadiusFor(const ImageGeometry& geometry);
+
+struct CortexFit {
+  bool found = false;
+  double offset_mm = 0;        // the outer (periosteal) surface along u
+  double thickness_mm = 0;     // the cortex
+  double outside_hu = 0, cortex_hu = 0, inside_hu = 0;
+  double sum_squares = 0;      // of the residuals, HU^2
+};
+
+/// The blurred-cortex model fitted to `line` with the scanner's Gaussian
+/// point-spread `sigma_mm` (the voxel's extent is added), the surface
+/// searched within 1 mm of `guess_mm`. Not found when the fit puts no
+/// bright layer on the bone side (cortex or bone at least
+/// `min_contrast_hu` above the outside) or the surface at the search's end.
+CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
+
+struct PointSpread {
+  bool found = false;
+  double sigma_mm = 0;    // the scanner's Gaussian point-spread (standard deviation)
+  int profiles = 0;       // lines it was estimated on
+  std::vector<double> grid_mm, sum_squares;  // the summed residuals over the lines, by sigma
+};
+
+/// The one point-spread that lets the blurred-cortex model fit `lines`
+/// (with their edge guesses) best: the least summed residual over sigma,
+/// refined by a parabola. Not found with fewer than 30 lines or when the
+/// least lies at the end of the range searched (0.05-2 mm).
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, const std::vector<double>& guesses_mm);
+
+}  // namespace articula::imaging

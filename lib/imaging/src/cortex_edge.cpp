@@ -1,0 +1,202 @@
+#include "articula/imaging/cortex_edge.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <nlopt.hpp>
+
+#include "articula/core/parallel.hpp"
+
+namespace articula::imaging {
+namespace {
+
+constexpr double kSearchMm = 1.0;        // the surface is sought this far either side of the guess
+constexpr double kMinThicknessMm = 0.1, kMaxThicknessMm = 4.0;
+constexpr double kMinGapMm = 0.8, kMaxGapMm = 4.0;  // the narrowest joint gaps are about 1.5 mm
+constexpr int kMinLines = 30;
+
+double Phi(double z) { return 0.5 * std::erfc(-z * M_SQRT1_2); }
+
+/// The blurred steps at surface e, cortex thickness t and gap g (to a socket
+/// beyond the surface), with the HU levels that fit the voxels best:
+/// f = outside + a (cortex layer) + b (cancellous) + c (socket), the levels
+/// a, b, c relative to the outside. A small ridge on b and c keeps them at
+/// the outside's level when the window does not reach them (a cortex
+/// thicker than the window, a gap wider than it).
+struct Levels {
+  Eigen::Vector4d coef = Eigen::Vector4d::Zero();  // outside, cortex - outside, cancellous - outside, socket - outside
+  double sum_squares = 0;
+};
+
+/// Least squares over the columns in `use` (the others held at zero).
+Levels solveLevels(const std::vector<Eigen::Vector4d>& rows, const std::vector<double>& values,
+                   const Eigen::Vector4d& use) {
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Eigen::Vector4d r = rows[i].cwiseProduct(use);
+    normal.selfadjointView<Eigen::Lower>().rankUpdate(r);
+    rhs += r * values[i];
+  }
+  normal = normal.selfadjointView<Eigen::Lower>();
+  // A tiny ridge: a level the window does not reach (a cortex thicker than
+  // it) stays at the outside's instead of making the system singular.
+  normal.diagonal().array() += 1e-6 * static_cast<double>(rows.size());
+  Levels l;
+  l.coef = normal.ldlt().solve(rhs).cwiseProduct(use);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double r = rows[i].dot(l.coef) - values[i];
+    l.sum_squares += r * r;
+  }
+  return l;
+}
+
+/// The blurred steps at surface e, cortex thickness t and gap g (to a socket
+/// beyond the surface), with the HU levels that fit the voxels best:
+/// f = outside + a (cortex layer) + b (cancellous) + c (socket), the levels
+/// relative to the outside. The socket is brighter than the gap or absent:
+/// a darker step there would reshape the surface's own fall and trade
+/// against the blur.
+Levels fitLevels(const LineVoxels& line, double e, double t, double g, double sigma) {
+  const size_t n = line.offset_mm.size();
+  std::vector<Eigen::Vector4d> rows(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double s = line.offset_mm[i];
+    const double k0 = Phi((e - s) / sigma), k1 = Phi((e - t - s) / sigma), k2 = Phi((s - e - g) / sigma);
+    rows[i] = Eigen::Vector4d(1.0, k0 - k1, k1, k2);
+  }
+  Levels l = solveLevels(rows, line.value_hu, Eigen::Vector4d::Ones());
+  if (l.coef[3] < 0) l = solveLevels(rows, line.value_hu, Eigen::Vector4d(1, 1, 1, 0));
+  return l;
+}
+
+struct Objective {
+  const LineVoxels* line;
+  double sigma;
+};
+
+double sumSquares(unsigned, const double* p, double*, void* data) {
+  const auto* o = static_cast<const Objective*>(data);
+  return fitLevels(*o->line, p[0], p[1], p[2], o->sigma).sum_squares;
+}
+
+}  // namespace
+
+double lineRadiusFor(const ImageGeometry& geometry) {
+  constexpr double kVoxels = 50;
+  const double voxel_volume = geometry.spacing.prod();
+  return std::max(0.8, std::sqrt(kVoxels * voxel_volume / (M_PI * (kCortexInwardMm + kCortexOutwardMm))));
+}
+
+LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
+                           double to_mm, double radius_mm) {
+  const ImageGeometry& g = volume.geometry;
+  LineVoxels line;
+  for (int a = 0; a < 3; ++a) {
+    const double along = g.spacing[a] * g.direction.col(a).dot(u);
+    line.box_variance_mm2 += along * along / 12.0;
+  }
+  // The index box around the segment, widened by the radius.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
+  for (const double s : {from_mm, to_mm}) {
+    const Eigen::Vector3d idx = g.toIndex(x + s * u);
+    lo = lo.cwiseMin(idx);
+    hi = hi.cwiseMax(idx);
+  }
+  const Eigen::Vector3d pad = g.spacing.cwiseInverse() * radius_mm;
+  Eigen::Vector3i first, last;
+  for (int a = 0; a < 3; ++a) {
+    first[a] = std::max(0, static_cast<int>(std::floor(lo[a] - pad[a])));
+    last[a] = std::min(g.size[a] - 1, static_cast<int>(std::ceil(hi[a] + pad[a])));
+    if (first[a] > last[a]) return line;
+  }
+  const double r2 = radius_mm * radius_mm;
+  for (int k = first[2]; k <= last[2]; ++k)
+    for (int j = first[1]; j <= last[1]; ++j)
+      for (int i = first[0]; i <= last[0]; ++i) {
+        const Eigen::Vector3d d = g.toPhysical(Eigen::Vector3d(i, j, k)) - x;
+        const double s = d.dot(u);
+        if (s < from_mm || s > to_mm || d.squaredNorm() - s * s > r2) continue;
+        line.offset_mm.push_back(s);
+        line.value_hu.push_back(volume.at(i, j, k));
+      }
+  return line;
+}
+
+CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu) {
+  CortexFit fit;
+  if (line.offset_mm.size() < 12 || !(sigma_mm > 0)) return fit;
+  Objective objective{&line, std::sqrt(sigma_mm * sigma_mm + line.box_variance_mm2)};
+  // BOBYQA: three bounded parameters, a cheap smooth objective without
+  // derivatives (the levels are solved inside it, variable projection).
+  nlopt::opt opt(nlopt::LN_BOBYQA, 3);
+  opt.set_lower_bounds({guess_mm - kSearchMm, kMinThicknessMm, kMinGapMm});
+  opt.set_upper_bounds({guess_mm + kSearchMm, kMaxThicknessMm, kMaxGapMm});
+  opt.set_min_objective(sumSquares, &objective);
+  opt.set_xtol_abs(1e-3);
+  opt.set_maxeval(300);
+  std::vector<double> p = {guess_mm, 1.0, 2.0};
+  double best = 0;
+  try {
+    opt.optimize(p, best);
+  } catch (const std::exception&) {
+    return fit;  // a failed search finds nothing; the caller keeps its own edge
+  }
+  const Levels l = fitLevels(line, p[0], p[1], p[2], objective.sigma);
+  fit.offset_mm = p[0];
+  fit.thickness_mm = p[1];
+  fit.outside_hu = l.coef[0];
+  fit.cortex_hu = l.coef[0] + l.coef[1];
+  fit.inside_hu = l.coef[0] + l.coef[2];
+  fit.sum_squares = l.sum_squares;
+  const bool bright_bone = std::max(l.coef[1], l.coef[2]) >= min_contrast_hu;
+  const bool inside_search = std::abs(p[0] - guess_mm) < 0.98 * kSearchMm;
+  fit.found = bright_bone && inside_search && std::isfinite(l.sum_squares);
+  return fit;
+}
+
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, const std::vector<double>& guesses_mm) {
+  PointSpread ps;
+  ps.profiles = static_cast<int>(lines.size());
+  if (lines.size() < static_cast<size_t>(kMinLines) || guesses_mm.size() != lines.size()) return ps;
+  // Summed over the same lines at every sigma; a line found at no sigma adds its
+  // fit anyway (its residual still tells how well that sigma explains it).
+  const auto total = [&](double sigma) {
+    std::vector<double> each(lines.size());
+    parallelFor(static_cast<std::ptrdiff_t>(lines.size()), 8, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+      for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
+        each[i] = fitCortex(lines[i], guesses_mm[i], sigma, 0.0).sum_squares;
+    });
+    double sum = 0;
+    for (const double e : each) sum += e;  // in order: the same sum for any thread count
+    return sum;
+  };
+  constexpr double kStep = 0.1, kFirst = 0.05, kLast = 2.0;
+  for (double s = kFirst; s <= kLast + 1e-9; s += kStep) {
+    ps.grid_mm.push_back(s);
+    ps.sum_squares.push_back(total(s));
+  }
+  const auto at = std::min_element(ps.sum_squares.begin(), ps.sum_squares.end()) - ps.sum_squares.begin();
+  if (at == 0 || at + 1 == static_cast<long>(ps.grid_mm.size())) return ps;
+  // Refined by a golden-section search between the grid's neighbours of the least.
+  constexpr double kInvPhi = 0.6180339887498949;
+  double a = ps.grid_mm[static_cast<size_t>(at) - 1], b = ps.grid_mm[static_cast<size_t>(at) + 1];
+  double c = b - kInvPhi * (b - a), d = a + kInvPhi * (b - a);
+  double fc = total(c), fd = total(d);
+  while (b - a > 0.004) {
+    if (fc < fd) {
+      b = d, d = c, fd = fc;
+      c = b - kInvPhi * (b - a), fc = total(c);
+    } else {
+      a = c, c = d, fc = fd;
+      d = a + kInvPhi * (b - a), fd = total(d);
+    }
+  }
+  ps.sigma_mm = 0.5 * (a + b);
+  ps.found = true;
+  return ps;
+}
+
+}  // namespace articula::imaging
