@@ -38,9 +38,9 @@ class MeshCommand : public cli::Command {
         ->check(CLI::Range(0.0, 10.0))
         ->capture_default_str();
     app.add_option("--edge-model", edge_model_,
-                   "With --ct: 'cortex' places each edge on the outer surface of a blurred-cortex model fitted to the "
-                   "voxels about the normal (a thin cortex does not pull it outwards); 'steepest' keeps the steepest "
-                   "fall")
+                   "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
+                   "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
+                   "the voxels about the normal, with one point-spread for the CT")
         ->check(CLI::IsMember({"cortex", "steepest"}))
         ->capture_default_str();
     app.add_option("--point-spread", snap_.point_spread_mm,
@@ -121,7 +121,7 @@ class MeshCommand : public cli::Command {
 
  private:
   std::filesystem::path input_, output_, ct_;
-  std::string smoothing_ = "laplacian", series_uid_, edge_model_ = "cortex";
+  std::string smoothing_ = "laplacian", series_uid_, edge_model_ = "steepest";
   mesh::EdgeSnapOptions snap_;
   bool all_components_ = false;
   mesh::MeshOptions options_;

@@ -91,7 +91,7 @@ double lineRadiusFor(const ImageGeometry& geometry) {
 }
 
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
-                           double to_mm, double radius_mm) {
+                           double to_mm, double radius_mm, double curvature_per_mm) {
   const ImageGeometry& g = volume.geometry;
   LineVoxels line;
   for (int a = 0; a < 3; ++a) {
@@ -117,9 +117,9 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
     for (int j = first[1]; j <= last[1]; ++j)
       for (int i = first[0]; i <= last[0]; ++i) {
         const Eigen::Vector3d d = g.toPhysical(Eigen::Vector3d(i, j, k)) - x;
-        const double s = d.dot(u);
-        if (s < from_mm || s > to_mm || d.squaredNorm() - s * s > r2) continue;
-        line.offset_mm.push_back(s);
+        const double s = d.dot(u), lateral2 = d.squaredNorm() - s * s;
+        if (s < from_mm || s > to_mm || lateral2 > r2) continue;
+        line.offset_mm.push_back(s + 0.5 * curvature_per_mm * lateral2);
         line.value_hu.push_back(volume.at(i, j, k));
       }
   return line;

@@ -222,18 +222,45 @@ void EdgeSnapOptions::validate() const {
 
 namespace {
 
+/// Each vertex's mean curvature (1/mm, positive where convex): the normal
+/// curvature along each edge, (n_j - n_i).(x_j - x_i) / |x_j - x_i|^2,
+/// averaged over the edges, then over the neighbours (a smoothed label's
+/// normals are noisy), within +-1/5 mm.
+std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours) {
+  const size_t n = neighbours.size();
+  std::vector<double> edge_mean(n, 0.0), smoothed(n, 0.0);
+  for (size_t i = 0; i < n; ++i) {
+    double sum = 0;
+    for (const int j : neighbours[i]) {
+      const Eigen::Vector3d dx = (mesh.vertices.row(j) - mesh.vertices.row(static_cast<Eigen::Index>(i))).transpose();
+      const Eigen::Vector3d dn = (mesh.normals.row(j) - mesh.normals.row(static_cast<Eigen::Index>(i))).transpose();
+      if (dx.squaredNorm() > 0) sum += dn.dot(dx) / dx.squaredNorm();
+    }
+    if (!neighbours[i].empty()) edge_mean[i] = sum / static_cast<double>(neighbours[i].size());
+  }
+  for (size_t i = 0; i < n; ++i) {
+    double sum = edge_mean[i];
+    for (const int j : neighbours[i]) sum += edge_mean[static_cast<size_t>(j)];
+    smoothed[i] = std::clamp(sum / static_cast<double>(neighbours[i].size() + 1), -0.2, 0.2);
+  }
+  return smoothed;
+}
+
 /// Moves the found steepest falls (`shift` along the normals) onto the
 /// outer surface of the blurred-cortex model, with one point-spread for the
 /// whole CT (given, or estimated on up to 300 of the found edges spread over
 /// the surface). A vertex whose model does not fit keeps its steepest fall.
-void placeOnCortexModel(const TriangleMesh& mesh, const imaging::Volume& ct, const std::vector<char>& found,
-                        std::vector<double>& shift, const EdgeSnapOptions& options, EdgeSnapSummary& s) {
+void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
+                        const imaging::Volume& ct, const std::vector<char>& found, std::vector<double>& shift,
+                        const EdgeSnapOptions& options, EdgeSnapSummary& s) {
   constexpr size_t kPointSpreadLines = 300;
   const double radius = imaging::lineRadiusFor(ct.geometry);
+  const std::vector<double> curvature = meanCurvature(mesh, neighbours);
   const auto lineAt = [&](Eigen::Index v) {
     const Eigen::Vector3d n = mesh.normals.row(v).transpose();
     const Eigen::Vector3d x = mesh.vertices.row(v).transpose() + shift[static_cast<size_t>(v)] * n;
-    return imaging::voxelsAboutLine(ct, x, n, -imaging::kCortexInwardMm, imaging::kCortexOutwardMm, radius);
+    return imaging::voxelsAboutLine(ct, x, n, -imaging::kCortexInwardMm, imaging::kCortexOutwardMm, radius,
+                                    curvature[static_cast<size_t>(v)]);
   };
   std::vector<Eigen::Index> on_edge;
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
@@ -303,9 +330,6 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     if (summary) *summary = s;
     return;
   }
-  if (options.cortex_model) placeOnCortexModel(mesh, ct, found, shift, options, s);
-  // Neighbour averages over the triangles' edges: the found shifts smoothed,
-  // the others taken from found neighbours (repeatedly, as far as the passes reach).
   std::vector<std::vector<int>> neighbours(static_cast<size_t>(n));
   for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
     for (int e = 0; e < 3; ++e) {
@@ -313,6 +337,9 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
       neighbours[static_cast<size_t>(a)].push_back(b);
       neighbours[static_cast<size_t>(b)].push_back(a);
     }
+  if (options.cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
+  // Neighbour averages over the triangles' edges: the found shifts smoothed,
+  // the others taken from found neighbours (repeatedly, as far as the passes reach).
   const int passes = std::max(options.smoothing_passes, 1);
   for (int pass = 0; pass < passes + 8; ++pass) {
     std::vector<double> next = shift;

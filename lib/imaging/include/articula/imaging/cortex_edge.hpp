@@ -24,13 +24,15 @@ namespace articula::imaging {
 
 /// The voxels whose centres lie within `radius_mm` of the line x + s u,
 /// s in [from_mm, to_mm] (u a unit vector pointing out of the bone): their
-/// offsets s along the line and their values.
+/// offsets along the line from a surface through x of mean curvature
+/// `curvature_per_mm` (positive where convex; a voxel at a distance l from
+/// the line lies l^2 curvature / 2 further out than its s), and their values.
 struct LineVoxels {
   std::vector<double> offset_mm, value_hu;
   double box_variance_mm2 = 0;  // the voxel's extent along u, as a variance (partial volume)
 };
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
-                           double to_mm, double radius_mm);
+                           double to_mm, double radius_mm, double curvature_per_mm = 0);
 
 /// The window the model is fitted over: from kCortexInwardMm inside an edge
 /// (the cortex and some cancellous bone) to kCortexOutwardMm outside it (the

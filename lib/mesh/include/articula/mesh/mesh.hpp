@@ -50,8 +50,11 @@ struct EdgeSnapOptions {
   int smoothing_passes = 2;     // neighbour averages of the shifts (CT noise)
   /// Each steepest fall moved onto the outer surface of a blurred-cortex
   /// model fitted to the voxels about the normal (imaging/cortex_edge.hpp),
-  /// which a thin cortex does not pull outwards. Off: the steepest fall.
-  bool cortex_model = true;
+  /// which a thin cortex does not pull outwards. Off by default: the
+  /// surface then rests on the point-spread estimated from the same CT, and
+  /// an estimate a few hundredths of a millimetre off moves it about three
+  /// times as far (docs/benchmarks.md, "Blurred-cortex edges").
+  bool cortex_model = false;
   /// The scanner's Gaussian point-spread for the model, mm (0: estimated
   /// from the CT's own edges).
   double point_spread_mm = 0;
