@@ -50,7 +50,7 @@ def matrix(quick):
     return cts
 
 
-def run_ct(ct, bin_dir, work):
+def run_ct(ct, bin_dir, work, run_args=()):
     """Makes the phantom, runs each side and scores it; returns one row per head."""
     d = os.path.join(work, ct["id"])
     cmd = [f"{bin_dir}/articula", "phantom", "-o", f"{d}/ct", "--seed", str(ct["seed"]), "--exact", "--force", "-q",
@@ -71,7 +71,7 @@ def run_ct(ct, bin_dir, work):
         out = f"{d}/run-{side}"
         t0 = time.time()
         r = subprocess.run([f"{bin_dir}/articula", "run", "-i", source, "-o", out, "--joint", "hip", "--side", side,
-                            "--force", "-q", "--threads", "1"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            "--force", "-q", "--threads", "1", *run_args], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                            text=True)
         head = next(h for h in truth["hips"] if h["side"] == side)
         row = dict(ct, side=side, exit=r.returncode, seconds=round(time.time() - t0, 1), phantom_s=round(phantom_s, 1),
@@ -140,16 +140,20 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("-j", type=int, default=2)
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--ids", default="", help="comma-separated case ids to run (default: the whole matrix)")
+    ap.add_argument("--run-args", default="", help="extra arguments for articula run, e.g. '--edge-model cortex'")
     args = ap.parse_args()
     bin_dir = os.path.abspath(args.bin)
     os.makedirs(args.work, exist_ok=True)
     cts = matrix(args.quick)
+    if args.ids:
+        cts = [c for c in cts if c["id"] in args.ids.split(",")]
     # Largest first, so that the slowest CTs do not finish last.
     order = sorted(cts, key=lambda c: (-len(c["sides"]) * (1.0 / (c["spacing"][0] ** 2 * c["spacing"][2]))))
     t0 = time.time()
     rows = []
     with futures.ThreadPoolExecutor(max_workers=args.j) as pool:
-        for done in futures.as_completed([pool.submit(run_ct, c, bin_dir, args.work) for c in order]):
+        for done in futures.as_completed([pool.submit(run_ct, c, bin_dir, args.work, args.run_args.split()) for c in order]):
             for r in done.result():
                 rows.append(r)
                 print(f"{r['id']} {r['side']}: {r['verdict']} (exit {r['exit']}, {r['seconds']} s)", file=sys.stderr)

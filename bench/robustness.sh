@@ -10,16 +10,18 @@
 # correct). Prints a markdown table of the shares per spacing group and one
 # row per head, then the selected model against the true model (a confusion
 # matrix); writes WORK/robustness.md and WORK/robustness.json.
-#   bash bench/robustness.sh [-j N] [--quick] [build/bin] [WORK]
+#   bash bench/robustness.sh [-j N] [--quick] [--ids g0-00,g0-03] [--run-args '--edge-model cortex'] [build/bin] [WORK]
 # Needs build/bin/articula and build/bin/bench-score-head (the scorer).
 set -euo pipefail
-jobs=2 quick=()
+jobs=2 quick=() extra=()
 args=()
 while (($#)); do
   case $1 in
     -j) jobs=$2; shift 2 ;;
     -j*) jobs=${1#-j}; shift ;;
     --quick) quick=(--quick); shift ;;
+    --ids) extra+=(--ids "$2"); shift 2 ;;
+    --run-args) extra+=(--run-args "$2"); shift 2 ;;
     *) args+=("$1"); shift ;;
   esac
 done
@@ -28,4 +30,4 @@ work=${args[1]:-$(mktemp -d)}
 for exe in articula bench-score-head; do
   [[ -x "$bin/$exe" ]] || { echo "robustness.sh: expected $bin/$exe (build it first)" >&2; exit 2; }
 done
-exec python3 "$(dirname "$0")/robustness.py" --bin "$bin" --work "$work" -j "$jobs" "${quick[@]}"
+exec python3 "$(dirname "$0")/robustness.py" --bin "$bin" --work "$work" -j "$jobs" "${quick[@]}" "${extra[@]}"
