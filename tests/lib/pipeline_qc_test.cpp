@@ -1,7 +1,9 @@
 // Head checks: a head's cap passes; each wrong structure fails the check
 // made to reveal it (a socket's inner surface, a small trochanter-like
 // blob, a cut cap, a non-spherical patch, a search that found elsewhere,
-// a side the search could not tell).
+// a side the search could not tell, points inside the bone).
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "articula/geometry/fibonacci.hpp"
@@ -112,6 +114,51 @@ TEST(HeadQc, TwoDoubtsTogetherFail) {
   EXPECT_EQ(check(r, "sphere_rms_relative").status, "warn");
   EXPECT_EQ(check(r, "doubtful_checks").status, "fail");
   EXPECT_EQ(check(r, "doubtful_checks").value, 2);
+  EXPECT_EQ(r.status, "fail");
+}
+
+/// A head of radius 22 mm about `centre`: a thin cortex (1 mm at 700 HU
+/// over 120 HU cancellous bone), soft tissue around, a socket shell 2.5 mm
+/// beyond; blurred radially (0.6 mm), on 0.8 mm voxels.
+imaging::Volume faintHead(const Eigen::Vector3d& centre) {
+  imaging::Volume v;
+  const double h = 0.8;
+  v.geometry.size = Eigen::Vector3i(80, 80, 80);
+  v.geometry.spacing = Eigen::Vector3d::Constant(h);
+  v.geometry.origin = centre - Eigen::Vector3d::Constant(39.5 * h);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  const double s = 0.6;
+  for (int k = 0; k < 80; ++k)
+    for (int j = 0; j < 80; ++j)
+      for (int i = 0; i < 80; ++i) {
+        const double r = (v.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - centre).norm();
+        const double head = 40 + 660 * Phi((22 - r) / s) - 580 * Phi((21 - r) / s);
+        const double socket = 900 * (Phi((r - 24.5) / s) - Phi((r - 29.5) / s));
+        v.at(i, j, k) = static_cast<float>(head + socket);
+      }
+  return v;
+}
+
+TEST(HeadQc, PointsInsideTheBoneFailOnTheCtsEdges) {
+  // On the head's surface the points pass; from a label that a bone window
+  // cut 2.5 mm inside a faint cortex, they fail (the structure is right,
+  // its surface is not).
+  pipeline::HeadQcInput in = cap(22, 80);
+  const imaging::Volume ct = faintHead(in.sphere_center);
+  in.ct_edges = pipeline::pointsOnCtEdge(ct, in.points, in.normals);
+  EXPECT_GT(in.ct_edges->on_edge, 0.95);
+  EXPECT_LT(in.ct_edges->inside_bone, 0.02);
+  EXPECT_EQ(pipeline::checkHead(in).status, "pass");
+
+  pipeline::HeadQcInput cut = cap(19.5, 80);
+  cut.sphere_center = in.sphere_center;
+  cut.ct_edges = pipeline::pointsOnCtEdge(ct, cut.points, cut.normals);
+  EXPECT_LT(cut.ct_edges->on_edge, 0.05);
+  EXPECT_GT(cut.ct_edges->inside_bone, 0.95);
+  const pipeline::QcReport r = pipeline::checkHead(cut);
+  EXPECT_EQ(check(r, "points_inside_bone_share").status, "fail");
+  EXPECT_EQ(check(r, "points_on_ct_edge_share").status, "fail");
   EXPECT_EQ(r.status, "fail");
 }
 

@@ -437,8 +437,17 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   const double mid_x = body_mid ? *body_mid : g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
   const bool side_by_position = body_mid.has_value() || wide;
   const double midline_margin = side_by_position ? effectiveMidlineMargin(g, options) : 0.0;
-  const auto onSide = [&](const Eigen::Vector3d& x) {
-    return !side_by_position || ((x[0] < mid_x) == right && std::abs(x[0] - mid_x) >= midline_margin);
+  // A head lies on its side of the middle and clear of it: structures on
+  // the midline (a sacrum, a symphysis) can look round. Within the margin a
+  // head is still taken when its socket lies medially on the asked side (a
+  // field of view that is wide but not centred on the body puts a real head
+  // near the field's middle).
+  const auto onSide = [&](const HeadCandidate& c) {
+    if (!side_by_position) return true;
+    if ((c.center[0] < mid_x) != right) return false;
+    if (std::abs(c.center[0] - mid_x) >= midline_margin) return true;
+    const std::optional<Side> by_socket = sideBySocket(volume, c, options);
+    return by_socket && *by_socket == options.side;
   };
   side.how = body_mid ? "left or right of the body's middle (x = " + std::to_string(*body_mid) + " mm, from its outline)"
                : wide   ? "left or right of the field of view's middle"
@@ -480,8 +489,8 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   // A head's size and share of bone surface, on the side, in the volume;
   // measured by rays, its edges must also make a sphere.
   const auto plausibleSphere = [&](const HeadCandidate& c) {
-    return c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage && onSide(c.center) &&
-           insideVolume(g, c.center);
+    return c.radius >= r_lo && c.radius <= r_hi && c.coverage >= options.min_coverage && insideVolume(g, c.center) &&
+           onSide(c);
   };
   const auto plausible = [&](const HeadCandidate& c) { return c.wellMeasured(g.spacing.maxCoeff()) && plausibleSphere(c); };
   const HeadCandidate* best = nullptr;
@@ -520,10 +529,13 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
     head = *best;
     return true;
   }
-  // No candidate's edges make a sphere: coarse voxels (3 mm) blur the gap
-  // away and the rays meet socket and pelvis. Then the strongest peak whose
-  // sphere through the surface voxels facing it (at about its radius) is a
-  // plausible head; no cut along edges follows (edge_mm stays empty).
+  // No candidate's edges make a sphere: coarse voxels (2-3 mm slices) blur
+  // the gap away and the rays meet socket and pelvis. Then the strongest
+  // peak whose sphere through the surface voxels facing it (at about its
+  // radius) is a plausible head; no cut along edges follows (edge_mm stays
+  // empty). With finer voxels the rays see a head's edges: a rounded corner
+  // of other bone (a sacrum's) would be all this finds, so nothing is taken.
+  if (g.spacing.maxCoeff() < kSeparateEdgesMaxVoxelMm - 1e-6) return false;
   const double cell_area = cg.spacing.prod() / cg.spacing.minCoeff();
   for (const Peak& p : kept) {
     HeadCandidate c = sphereOfFacingVoxels(p.x, voters, options, cg.spacing.minCoeff(), cell_area);

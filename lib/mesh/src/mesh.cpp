@@ -316,9 +316,27 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   std::vector<char> found(static_cast<size_t>(n), 0);
   EdgeSnapSummary s;
   s.vertices = n;
+  // Where the window holds no fall, or its steepest at its outer end, the
+  // label may end inside the bone (a cortex so faint that the bone window
+  // cuts it millimetres inside its edge): the first fall met going out,
+  // taken only when the way to it stays in bone (above the middle of that
+  // fall), so that a socket's cortex beyond a joint gap is never taken.
+  const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
+  const bool look_further = ct.geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6;
+  const auto throughBone = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& u, const imaging::Edge& edge) {
+    const double middle = 0.5 * (edge.inside_hu + edge.outside_hu);
+    for (double t = 0; t <= edge.offset_mm - 0.5; t += 0.1)
+      if (!(imaging::interpolate(ct, x + t * u) >= middle)) return false;
+    return true;
+  };
   for (Eigen::Index v = 0; v < n; ++v) {
-    const imaging::Edge e =
-        imaging::locateEdge(ct, mesh.vertices.row(v).transpose(), mesh.normals.row(v).transpose(), search);
+    const Eigen::Vector3d x = mesh.vertices.row(v).transpose(), u = mesh.normals.row(v).transpose();
+    imaging::Edge e = imaging::locateEdge(ct, x, u, search);
+    if (look_further && (!e.found || e.offset_mm > search.outward_mm - 0.15)) {
+      imaging::Edge further = imaging::firstEdgeAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
+      further.offset_mm -= search.inward_mm;
+      if (further.found && (!e.found || further.offset_mm > e.offset_mm) && throughBone(x, u, further)) e = further;
+    }
     if (!e.found) continue;
     shift[static_cast<size_t>(v)] = e.offset_mm;
     found[static_cast<size_t>(v)] = 1;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "articula/core/error.hpp"
+#include "articula/imaging/edges.hpp"
 
 namespace articula::pipeline {
 namespace {
@@ -18,6 +19,8 @@ constexpr double kOutwardFail = 0.90, kOutwardWarn = 0.97;
 constexpr double kRmsWarn = 0.04, kRmsFail = 0.08;            // of the radius
 constexpr double kCentreWarn = 0.15, kCentreFail = 0.30;      // search vs fit, of the radius
 constexpr double kRadiusWarn = 0.15, kRadiusFail = 0.30;      // relative difference
+constexpr double kEdgeFail = 0.5, kEdgeWarn = 0.7;            // share of the points on the CT's edge
+constexpr double kInsideWarn = 0.05, kInsideFail = 0.15;      // share of the points inside the bone
 constexpr int kDoubtsThatFail = 2;                              // warnings of the structure's checks
 
 std::string number(double v) {
@@ -55,6 +58,29 @@ nlohmann::json QcReport::toJson() const {
   for (const QcCheck& c : checks)
     checks_json.push_back({{"name", c.name}, {"status", c.status}, {"value", c.value}, {"rule", c.rule}, {"reason", c.reason}});
   return {{"status", status}, {"checks", checks_json}, {"reasons", reasons()}};
+}
+
+PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& normals) {
+  PointsOnCtEdge shares;
+  if (points.rows() == 0 || normals.rows() != points.rows()) return shares;
+  // The first bone edge met going out along the normal from 3 mm inside the
+  // point (not the steepest: beyond a narrow gap a socket's cortex falls to
+  // its cancellous bone, often more steeply than the head's own edge), which
+  // must lie within half a voxel of the point.
+  const double voxel = ct.geometry.spacing.maxCoeff();
+  const double reach = std::max(3.0, 1.5 * voxel), tolerance = std::max(0.5, 0.5 * voxel);
+  Eigen::Index on_edge = 0, inside = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Eigen::Vector3d n = normals.row(i).transpose().normalized();
+    const imaging::Edge e =
+        imaging::firstEdgeAlongRay(ct, points.row(i).transpose() - reach * n, n, 0.0, 2 * reach, imaging::EdgeSearch{});
+    const double offset = e.offset_mm - reach;
+    on_edge += e.found && std::abs(offset) <= tolerance;
+    inside += e.found && offset > tolerance;
+  }
+  shares.on_edge = static_cast<double>(on_edge) / static_cast<double>(points.rows());
+  shares.inside_bone = static_cast<double>(inside) / static_cast<double>(points.rows());
+  return shares;
 }
 
 QcReport checkHead(const HeadQcInput& in) {
@@ -102,6 +128,13 @@ QcReport checkHead(const HeadQcInput& in) {
     if (in.search_radius_mm > 0)
       report.checks.push_back(grade("search_radius_difference_relative", std::abs(in.search_radius_mm - r) / r, kRadiusWarn,
                                     kRadiusFail, false, "the head search's radius differs from the fitted one, relative:"));
+  }
+  if (in.ct_edges) {
+    report.checks.push_back(grade("points_on_ct_edge_share", in.ct_edges->on_edge, kEdgeWarn, kEdgeFail, true,
+                                  "share of the points on the CT's bone edge (within half a voxel):"));
+    report.checks.push_back(grade("points_inside_bone_share", in.ct_edges->inside_bone, kInsideWarn, kInsideFail, false,
+                                  "share of the points with the CT's bone edge further out (a label cut inside the "
+                                  "head, where a faint cortex fell below the bone window):"));
   }
   if (in.side_verified) {
     QcCheck side;

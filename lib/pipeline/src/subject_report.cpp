@@ -20,6 +20,7 @@
 #include "articula/geometry/shape.hpp"
 #include "articula/core/csv.hpp"
 #include "articula/pipeline/markups.hpp"
+#include "articula/imaging/edges.hpp"
 #include "articula/imaging/io.hpp"
 #include "articula/pipeline/head_slices.hpp"
 #include "articula/pipeline/head_view.hpp"
@@ -85,11 +86,19 @@ json readStageJson(const fs::path& path) {
 
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
-QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes) {
+QcReport checkSubjectHead(const SubjectReportOptions& o, const std::vector<geometry::ShapeParameters>& shapes) {
+  const fs::path& folder = o.folder;
   HeadQcInput in;
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
+  if (!o.ct.empty() && in.normals.rows() == in.points.rows()) {
+    imaging::ReadOptions read;
+    read.series_uid = o.series_uid;
+    const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, read);
+    if (ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
+      in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
+  }
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
   if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");
@@ -232,7 +241,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   SlicerSceneContent scene;
   scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
 
-  const QcReport qc = checkSubjectHead(o.folder, shapes);
+  const QcReport qc = checkSubjectHead(o, shapes);
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};

@@ -14,6 +14,12 @@
 
 namespace articula::imaging {
 
+/// The coarsest voxel (its longest side, mm) at which a joint head's edge
+/// stands apart from its socket's: beyond it (3 mm slices) the joint gap
+/// blurs away, and an edge further out than the label, or the lack of one
+/// at a point, tells nothing.
+constexpr double kSeparateEdgesMaxVoxelMm = 2.0;
+
 /// HU at a physical LPS point by trilinear interpolation; NaN outside the grid.
 double interpolate(const Volume& volume, const Eigen::Vector3d& x);
 

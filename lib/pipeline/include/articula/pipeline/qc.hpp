@@ -3,8 +3,10 @@
 // head's radius against plausible heads, the angular extent of the
 // articular cap, the share of point normals pointing away from the head's
 // centre (a socket's inner surface points towards it), the points' spread
-// about their sphere, the agreement of the head search with the fit, and
-// whether the search could tell the joint's side.
+// about their sphere, the agreement of the head search with the fit,
+// whether the search could tell the joint's side, and whether the CT shows
+// the bone's edge where the points are (a label cut inside the head, where
+// a faint cortex fell below the bone window, has points inside the bone).
 // Each check passes, warns (doubtful) or fails (the result is not a head).
 #include <optional>
 #include <string>
@@ -13,7 +15,14 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "articula/imaging/image.hpp"
+
 namespace articula::pipeline {
+
+struct PointsOnCtEdge {
+  double on_edge = 0;      // share of the points with the bone's edge within half a voxel (at least 0.5 mm)
+  double inside_bone = 0;  // share with the edge further out: the points lie inside the bone
+};
 
 struct HeadQcInput {
   Eigen::MatrixX3d points;                   // articular points (LPS mm)
@@ -23,6 +32,7 @@ struct HeadQcInput {
   std::optional<Eigen::Vector3d> search_center;  // the segmentation's head, if it searched
   double search_radius_mm = 0;
   std::optional<bool> side_verified;             // the search's side check, if it searched
+  std::optional<PointsOnCtEdge> ct_edges;        // where the CT's bone edge is about the points, if a CT was given
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
 };
 
@@ -38,6 +48,11 @@ struct QcReport {
   std::vector<std::string> reasons() const;  // of every check that did not pass
   nlohmann::json toJson() const;
 };
+
+/// Where the bone's edge in the CT (imaging::locateEdge: the steepest fall
+/// of at least 150 HU from bone within 3 mm along each outward normal) lies
+/// about `points`: the shares of the points on it and inside the bone.
+PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& normals);
 
 /// Runs every check that its inputs allow; throws InputError for fewer than 4 points.
 QcReport checkHead(const HeadQcInput& input);
