@@ -63,7 +63,7 @@ class SampleCommand : public cli::Command {
     sampling::DownsampleSummary ds;
     const std::vector<int> kept = sampling::gaussianDownsample(P, down_, &ds);
     if (static_cast<int>(kept.size()) < select_options_.min_points)
-      throw InputError("down-sampling left " + std::to_string(kept.size()) + " points; expected at least " +
+      throw ProcessingError("down-sampling left " + std::to_string(kept.size()) + " articular points; expected at least " +
                        std::to_string(select_options_.min_points) + " (reduce --ball-radius)");
     points::PointCloud cloud;
     cloud.positions.resize(static_cast<Eigen::Index>(kept.size()), 3);

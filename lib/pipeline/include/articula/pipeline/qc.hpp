@@ -49,9 +49,10 @@ struct QcReport {
   nlohmann::json toJson() const;
 };
 
-/// Where the bone's edge in the CT (imaging::locateEdge: the steepest fall
-/// of at least 150 HU from bone within 3 mm along each outward normal) lies
-/// about `points`: the shares of the points on it and inside the bone.
+/// Where the bone's edge in the CT (imaging::firstEdgeAlongRay: the first
+/// fall of at least 150 HU from bone going out along each outward normal
+/// from 3 mm inside) lies about `points`: the shares of the points within
+/// half a voxel (at least 0.5 mm) of it and inside the bone.
 PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& normals);
 
 /// Runs every check that its inputs allow; throws InputError for fewer than 4 points.
