@@ -222,6 +222,27 @@ void EdgeSnapOptions::validate() const {
 
 namespace {
 
+/// The bone's edge along the normal u at x: the steepest fall within the
+/// search window. Where the window holds no fall, or its steepest at its
+/// outer end, the label may end inside the bone (a cortex so faint that the
+/// bone window cuts it millimetres inside its edge); with `look_further`,
+/// the first fall met going out within 3 mm (1.5 voxels) is taken then, if
+/// the way to it stays in bone (above the middle of that fall), so that a
+/// socket's cortex beyond a joint gap is never taken.
+imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, const Eigen::Vector3d& u,
+                       const imaging::EdgeSearch& search, bool look_further) {
+  const imaging::Edge e = imaging::locateEdge(ct, x, u, search);
+  if (!look_further || (e.found && e.offset_mm <= search.outward_mm - 0.15)) return e;
+  const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
+  imaging::Edge further = imaging::firstEdgeAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
+  further.offset_mm -= search.inward_mm;
+  if (!further.found || (e.found && further.offset_mm <= e.offset_mm)) return e;
+  const double middle = 0.5 * (further.inside_hu + further.outside_hu);
+  for (double t = 0; t <= further.offset_mm - 0.5; t += 0.1)
+    if (!(imaging::interpolate(ct, x + t * u) >= middle)) return e;
+  return further;
+}
+
 /// Each vertex's mean curvature (1/mm, positive where convex): the normal
 /// curvature along each edge, (n_j - n_i).(x_j - x_i) / |x_j - x_i|^2,
 /// averaged over the edges, then over the neighbours (a smoothed label's
@@ -316,27 +337,10 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   std::vector<char> found(static_cast<size_t>(n), 0);
   EdgeSnapSummary s;
   s.vertices = n;
-  // Where the window holds no fall, or its steepest at its outer end, the
-  // label may end inside the bone (a cortex so faint that the bone window
-  // cuts it millimetres inside its edge): the first fall met going out,
-  // taken only when the way to it stays in bone (above the middle of that
-  // fall), so that a socket's cortex beyond a joint gap is never taken.
-  const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
   const bool look_further = ct.geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6;
-  const auto throughBone = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& u, const imaging::Edge& edge) {
-    const double middle = 0.5 * (edge.inside_hu + edge.outside_hu);
-    for (double t = 0; t <= edge.offset_mm - 0.5; t += 0.1)
-      if (!(imaging::interpolate(ct, x + t * u) >= middle)) return false;
-    return true;
-  };
   for (Eigen::Index v = 0; v < n; ++v) {
-    const Eigen::Vector3d x = mesh.vertices.row(v).transpose(), u = mesh.normals.row(v).transpose();
-    imaging::Edge e = imaging::locateEdge(ct, x, u, search);
-    if (look_further && (!e.found || e.offset_mm > search.outward_mm - 0.15)) {
-      imaging::Edge further = imaging::firstEdgeAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
-      further.offset_mm -= search.inward_mm;
-      if (further.found && (!e.found || further.offset_mm > e.offset_mm) && throughBone(x, u, further)) e = further;
-    }
+    const imaging::Edge e =
+        boneEdge(ct, mesh.vertices.row(v).transpose(), mesh.normals.row(v).transpose(), search, look_further);
     if (!e.found) continue;
     shift[static_cast<size_t>(v)] = e.offset_mm;
     found[static_cast<size_t>(v)] = 1;

@@ -79,8 +79,9 @@ struct EdgeSnapSummary {
 };
 
 /// Moves every vertex along its normal onto the CT's bone edge (the
-/// steepest HU fall, imaging::locateEdge, then the outer surface of the
-/// blurred-cortex model where it fits), so that the surface lies where
+/// steepest HU fall, imaging::locateEdge; where the window holds none, the
+/// first fall going out through bone, within 3 mm, for voxels up to 2 mm;
+/// with cortex_model, the outer surface of the blurred-cortex model), so that the surface lies where
 /// the cortex meets soft tissue at sub-voxel precision and not where the
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours.
