@@ -19,12 +19,7 @@ constexpr int kMinLines = 30;
 
 double Phi(double z) { return 0.5 * std::erfc(-z * M_SQRT1_2); }
 
-/// The blurred steps at surface e, cortex thickness t and gap g (to a socket
-/// beyond the surface), with the HU levels that fit the voxels best:
-/// f = outside + a (cortex layer) + b (cancellous) + c (socket), the levels
-/// a, b, c relative to the outside. A small ridge on b and c keeps them at
-/// the outside's level when the window does not reach them (a cortex
-/// thicker than the window, a gap wider than it).
+/// The HU levels of the model's steps and the residual they leave.
 struct Levels {
   Eigen::Vector4d coef = Eigen::Vector4d::Zero();  // outside, cortex - outside, cancellous - outside, socket - outside
   double sum_squares = 0;
@@ -180,7 +175,9 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, const std:
   }
   const auto at = std::min_element(ps.sum_squares.begin(), ps.sum_squares.end()) - ps.sum_squares.begin();
   if (at == 0 || at + 1 == static_cast<long>(ps.grid_mm.size())) return ps;
-  // Refined by a golden-section search between the grid's neighbours of the least.
+  // Refined by a golden-section search between the grid's neighbours of the
+  // least: one bracketed variable, 300 fits an evaluation; written out here
+  // (ten lines) rather than set up as another NLopt problem.
   constexpr double kInvPhi = 0.6180339887498949;
   double a = ps.grid_mm[static_cast<size_t>(at) - 1], b = ps.grid_mm[static_cast<size_t>(at) + 1];
   double c = b - kInvPhi * (b - a), d = a + kInvPhi * (b - a);
