@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "articula/core/json_file.hpp"
+#include "articula/core/log.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/number_text.hpp"
@@ -93,11 +94,18 @@ QcReport checkSubjectHead(const SubjectReportOptions& o, const std::vector<geome
   in.points = cloud.positions;
   in.normals = cloud.normals;
   if (!o.ct.empty() && in.normals.rows() == in.points.rows()) {
-    imaging::ReadOptions read;
-    read.series_uid = o.series_uid;
-    const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, read);
-    if (ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
-      in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
+    // The CT must be read as the segmentation read it; one that the report
+    // cannot read (a folder of several series without --series-uid) leaves
+    // these two checks out, with a warning, as the slices are left out.
+    try {
+      imaging::ReadOptions read;
+      read.series_uid = o.series_uid;
+      const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, read);
+      if (ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
+        in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
+    } catch (const Error& e) {
+      log::warn(std::string("report: the head checks against the CT are left out: ") + e.what());
+    }
   }
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
