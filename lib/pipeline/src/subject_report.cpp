@@ -87,26 +87,15 @@ json readStageJson(const fs::path& path) {
 
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
-QcReport checkSubjectHead(const SubjectReportOptions& o, const std::vector<geometry::ShapeParameters>& shapes) {
-  const fs::path& folder = o.folder;
+QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
+                          const imaging::Volume* ct) {
   HeadQcInput in;
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
-  if (!o.ct.empty() && in.normals.rows() == in.points.rows()) {
-    // The CT must be read as the segmentation read it; one that the report
-    // cannot read (a folder of several series without --series-uid) leaves
-    // these two checks out, with a warning, as the slices are left out.
-    try {
-      imaging::ReadOptions read;
-      read.series_uid = o.series_uid;
-      const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, read);
-      if (ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
-        in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
-    } catch (const Error& e) {
-      log::warn(std::string("report: the head checks against the CT are left out: ") + e.what());
-    }
-  }
+  if (ct && in.normals.rows() == in.points.rows() &&
+      ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
+    in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
   if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");
@@ -129,19 +118,34 @@ QcReport checkSubjectHead(const SubjectReportOptions& o, const std::vector<geome
   return checkHead(in);
 }
 
-// The report's CT slices through the selected model, or a note why there
-// are none (no CT given, one that cannot be read without options the report
-// does not take, a model that cannot be drawn): they show, they decide nothing.
-std::string slicesThroughHead(const SubjectReportOptions& o, const std::vector<geometry::ShapeParameters>& shapes,
-                              const std::string& selected) {
+// The subject's CT, read once for the checks against it and the slices; null
+// with the reason when none is given or it cannot be read without options
+// the report does not take (then both are left out, with a warning).
+std::shared_ptr<const imaging::Volume> readSubjectCt(const SubjectReportOptions& o, std::string& why_not) {
+  if (o.ct.empty()) {
+    why_not = "No CT given (--ct).";
+    return nullptr;
+  }
   try {
-    if (o.ct.empty()) return "<p class=\"note\">No CT given (--ct).</p>";
+    imaging::ReadOptions read;
+    read.series_uid = o.series_uid;
+    return imaging::readSharedVolume(o.ct, read);
+  } catch (const Error& e) {
+    why_not = std::string("No CT slices: ") + e.what();
+    log::warn(std::string("report: the head checks against the CT are left out: ") + e.what());
+    return nullptr;
+  }
+}
+
+// The report's CT slices through the selected model, or a note why there
+// are none (no CT, a model that cannot be drawn): they show, they decide nothing.
+std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volume* ct, const std::string& why_not,
+                              const std::vector<geometry::ShapeParameters>& shapes, const std::string& selected) {
+  if (!ct) return "<p class=\"note\">" + report::escapeMarkup(why_not) + "</p>";
+  try {
     geometry::ShapeParameters model;
     for (const auto& shape : shapes)
       if (geometry::modelName(shape.model) == selected) model = shape;
-    imaging::ReadOptions read;
-    read.series_uid = o.series_uid;
-    const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(o.ct, read);
     std::optional<imaging::Label> label;
     if (fs::exists(o.folder / "label.nii.gz")) label = imaging::readLabel(o.folder / "label.nii.gz");
     return headSlicesHtml(*ct, label ? &*label : nullptr, model, 1.6 * model.radii.maxCoeff(),
@@ -249,7 +253,9 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   SlicerSceneContent scene;
   scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
 
-  const QcReport qc = checkSubjectHead(o, shapes);
+  std::string no_ct;
+  const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
+  const QcReport qc = checkSubjectHead(o.folder, shapes, ct.get());
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
@@ -300,7 +306,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   }
   writeFileAtomically(o.folder / "scene.mrml", slicerSceneXml(scene));
   writeFileAtomically(o.folder / "report.html",
-                      subjectReportHtml(results, o.folder, slicesThroughHead(o, shapes, selection.selected), view_html));
+                      subjectReportHtml(results, o.folder, slicesThroughHead(o, ct.get(), no_ct, shapes, selection.selected), view_html));
   return qc;
 }
 
