@@ -80,7 +80,7 @@ Estimate measure(const FlatCortex& c, unsigned seed) {
       lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm,
                                                imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry)));
     }
-  e.spread = imaging::estimatePointSpread(lines, std::vector<double>(lines.size(), 0.0));
+  e.spread = imaging::estimatePointSpread(lines);
   for (size_t i = 0; i < lines.size(); ++i) {
     e.mean_steepest += starts[i] / static_cast<double>(lines.size());
     const imaging::CortexFit f = imaging::fitCortex(lines[i], 0.0, e.spread.sigma_mm);
@@ -123,7 +123,7 @@ TEST(CortexEdge, NothingFoundWithoutABrightLayerOrVoxels) {
   const auto line = imaging::voxelsAboutLine(v, flat.surface * flat.n, flat.n, -3.5, 2.5, 0.8);
   EXPECT_FALSE(imaging::fitCortex(line, 0.0, 0.5).found);
   EXPECT_FALSE(imaging::fitCortex(imaging::LineVoxels{}, 0.0, 0.5).found);
-  EXPECT_FALSE(imaging::estimatePointSpread({line}, {0.0}).found);  // one line is not enough
+  EXPECT_FALSE(imaging::estimatePointSpread({line}).found);  // one line is not enough
 }
 
 }  // namespace

@@ -152,17 +152,17 @@ CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, do
   return fit;
 }
 
-PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, const std::vector<double>& guesses_mm) {
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines) {
   PointSpread ps;
   ps.profiles = static_cast<int>(lines.size());
-  if (lines.size() < static_cast<size_t>(kMinLines) || guesses_mm.size() != lines.size()) return ps;
+  if (lines.size() < static_cast<size_t>(kMinLines)) return ps;
   // Summed over the same lines at every sigma; a line found at no sigma adds its
   // fit anyway (its residual still tells how well that sigma explains it).
   const auto total = [&](double sigma) {
     std::vector<double> each(lines.size());
     parallelFor(static_cast<std::ptrdiff_t>(lines.size()), 8, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
-        each[i] = fitCortex(lines[i], guesses_mm[i], sigma, 0.0).sum_squares;
+        each[i] = fitCortex(lines[i], 0.0, sigma, 0.0).sum_squares;
     });
     double sum = 0;
     for (const double e : each) sum += e;  // in order: the same sum for any thread count

@@ -291,7 +291,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     std::vector<imaging::LineVoxels> lines;
     const size_t stride = std::max<size_t>(1, on_edge.size() / kPointSpreadLines);
     for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i]));
-    const imaging::PointSpread ps = imaging::estimatePointSpread(lines, std::vector<double>(lines.size(), 0.0));
+    const imaging::PointSpread ps = imaging::estimatePointSpread(lines);
     if (!ps.found) {
       s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(ps.profiles) +
                             " edges; the edges are the steepest falls";

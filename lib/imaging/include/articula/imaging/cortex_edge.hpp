@@ -65,9 +65,9 @@ struct PointSpread {
 };
 
 /// The one point-spread that lets the blurred-cortex model fit `lines`
-/// (with their edge guesses) best: the least summed residual over sigma,
+/// (each centred on its edge's first guess) best: the least summed residual over sigma,
 /// refined by a parabola. Not found with fewer than 30 lines or when the
 /// least lies at the end of the range searched (0.05-2 mm).
-PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, const std::vector<double>& guesses_mm);
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
 
 }  // namespace articula::imaging
