@@ -457,5 +457,18 @@ def main():
     print("wrote", fn, "voxels", n.tolist(), "in %.0f s" % (time.time() - t0))
 
 
+def head_distances(errors_csv, truth_json, side):
+    """Each articular point of an `articula run` (errors/errors.csv) against
+    the true head of `side`: its radial distance (mm, positive outside) to
+    the head's ellipsoid, in the head's own frame."""
+    import csv
+    h = next(h for h in json.load(open(truth_json))["heads"] if h["side"] == side)
+    c, rad, A = np.array(h["head_center_mm"]), np.array(h["radii_mm"]), np.array(h["axes_lps_columns"])
+    P = np.array([[float(x[k]) for k in ("x_mm", "y_mm", "z_mm")] for x in csv.DictReader(open(errors_csv))])
+    L = (P - c) @ A
+    n = np.linalg.norm(L, axis=1)
+    return n - n / np.sqrt(((L / rad) ** 2).sum(1))
+
+
 if __name__ == "__main__":
     main()

@@ -98,10 +98,12 @@ for line in "${cases[@]}"; do
     out=run-$name-$side
     "$bin/articula" run -i "$name.nii.gz" -o "$out" --joint "$joint" --side "$side" --threads 1 --quiet --force 2> "$out.err"
     rc=$?
-    "$py" - "$out" "$name.json" "$side" "$rc" "$name" "$out.err" <<'PY'
-import csv, json, os, sys
+    "$py" - "$out" "$name.json" "$side" "$rc" "$name" "$out.err" "$here" <<'PY'
+import json, os, sys
 import numpy as np
-run, truth, side, rc, name, err = sys.argv[1:7]
+run, truth, side, rc, name, err, here = sys.argv[1:8]
+sys.path.insert(0, here)
+from third_phantom import head_distances
 t = json.load(open(truth)); o = t["options"]; sp = t["spacing_mm"]
 h = next(h for h in t["heads"] if h["side"] == side)
 qc = verdict = ""
@@ -113,13 +115,9 @@ if os.path.exists(f"{run}/results.json") and rc in ("0", "1"):
         pass
 if rc == "0":
     r = json.load(open(f"{run}/results.json"))
-    c = np.array(h["head_center_mm"]); rad = np.array(h["radii_mm"]); A = np.array(h["axes_lps_columns"])
     sel = next(m for m in r["models"] if m["model"] == r["selected_model"])
-    ce = np.linalg.norm(np.array([sel["parameters"][k] for k in ("t1_mm", "t2_mm", "t3_mm")]) - c)
-    P = np.array([[float(x[k]) for k in ("x_mm", "y_mm", "z_mm")] for x in csv.DictReader(open(f"{run}/errors/errors.csv"))])
-    L = (P - c) @ A  # in the head's frame
-    n = np.linalg.norm(L, axis=1); q = np.sqrt(((L / rad) ** 2).sum(1))
-    d = n - n / q  # radial distance to the true head
+    ce = np.linalg.norm(np.array([sel["parameters"][k] for k in ("t1_mm", "t2_mm", "t3_mm")]) - np.array(h["head_center_mm"]))
+    d = head_distances(f"{run}/errors/errors.csv", truth, side)
     rms = float(np.sqrt((d ** 2).mean())); within = float((np.abs(d) <= 1.5).mean())
     verdict = "correct" if rms <= 0.5 * sp[0] and within >= 0.95 else "SILENTLY WRONG"
     cells = [f"{ce:.2f}", f"{d.mean():+.3f}", f"{rms:.3f}", f"{100 * within:.0f} %"]

@@ -17,17 +17,14 @@ gen="$ARTICULA_SOURCE/bench/third_phantom.py"
 
 # score RUN TRUTH SIDE: exit 0 when the run's articular points lie on the true head.
 score() {
-  "$py" - "$1" "$2" "$3" <<'PY'
-import csv, json, sys
+  "$py" - "$1" "$2" "$3" "$ARTICULA_SOURCE/bench" <<'PY'
+import json, sys
 import numpy as np
-run, truth, side = sys.argv[1:4]
+run, truth, side, bench = sys.argv[1:5]
+sys.path.insert(0, bench)
+from third_phantom import head_distances
 t = json.load(open(truth))
-h = next(h for h in t["heads"] if h["side"] == side)
-c, rad, A = np.array(h["head_center_mm"]), np.array(h["radii_mm"]), np.array(h["axes_lps_columns"])
-P = np.array([[float(x[k]) for k in ("x_mm", "y_mm", "z_mm")] for x in csv.DictReader(open(f"{run}/errors/errors.csv"))])
-L = (P - c) @ A
-n = np.linalg.norm(L, axis=1)
-d = n - n / np.sqrt(((L / rad) ** 2).sum(1))
+d = head_distances(f"{run}/errors/errors.csv", truth, side)
 rms = float(np.sqrt((d ** 2).mean()))
 print(f"{run}: RMS {rms:.3f} mm to the true head, {100 * (np.abs(d) <= 1.5).mean():.0f} % within 1.5 mm")
 sys.exit(0 if rms <= 0.5 * t["spacing_mm"][0] and (np.abs(d) <= 1.5).mean() >= 0.95 else 1)
