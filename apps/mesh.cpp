@@ -44,8 +44,13 @@ class MeshCommand : public cli::Command {
         ->check(CLI::IsMember({"cortex", "steepest"}))
         ->capture_default_str();
     app.add_option("--point-spread", snap_.point_spread_mm,
-                   "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation), mm "
-                   "(0: estimated from the CT's edges)")
+                   "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation) within "
+                   "the slices, mm (0: this and the slices' estimated from the CT's edges)")
+        ->check(CLI::Range(0.0, 3.0))
+        ->capture_default_str();
+    app.add_option("--slice-point-spread", snap_.slice_point_spread_mm,
+                   "With --point-spread: the point-spread across the slices (the slice profile's standard deviation), "
+                   "mm (0: as within the slices)")
         ->check(CLI::Range(0.0, 3.0))
         ->capture_default_str();
   }
@@ -84,6 +89,7 @@ class MeshCommand : public cli::Command {
                {"mean_abs_shift_mm", snapped.mean_abs_shift_mm},
                {"edge_model", snapped.cortex_model ? "cortex" : "steepest"},
                {"point_spread_mm", snapped.point_spread_mm},
+               {"slice_point_spread_mm", snapped.slice_point_spread_mm},
                {"point_spread_estimated", snapped.point_spread_estimated},
                {"vertices_on_cortex_model", snapped.on_cortex_model},
                {"mean_model_shift_mm", snapped.mean_model_shift_mm}};
@@ -105,7 +111,8 @@ class MeshCommand : public cli::Command {
                              {"relaxation", options_.relaxation}, {"passband", options_.passband},
                              {"decimate", options_.decimate}, {"largest_component", options_.largest_component},
                              {"edge_search_mm", snap_.search_mm}, {"edge_model", edge_model_},
-                             {"point_spread_mm", snap_.point_spread_mm}};
+                             {"point_spread_mm", snap_.point_spread_mm},
+                             {"slice_point_spread_mm", snap_.slice_point_spread_mm}};
     nlohmann::json summary = {{"input", input_.string()},       {"output", output_.string()},
                               {"label_voxels", s.label_voxels}, {"raw_triangles", s.raw_triangles},
                               {"triangles", s.triangles},       {"vertices", s.vertices},

@@ -23,6 +23,9 @@ struct FlatCortex {
   double soft = 40, cortical = 700, cancellous = 190, thickness = 0.8, sigma = 0.5, spacing = 0.7, noise = 20;
   double surface = 0.23;
   Eigen::Vector3d n = Eigen::Vector3d(1, 0.21, -0.13).normalized();
+  Eigen::Vector3i size = Eigen::Vector3i(24, 40, 40);  // voxels (the grid centred on the origin)
+  // Two directions spanning the places where lines cross it (projected onto it).
+  Eigen::Vector3d across1 = Eigen::Vector3d::UnitY(), across2 = Eigen::Vector3d::UnitZ();
 
   /// The blurred profile at signed distance d beyond the surface (closed form).
   double blurred(double d) const {
@@ -41,19 +44,52 @@ struct FlatCortex {
   }
   imaging::Volume volume(unsigned seed) const {
     imaging::Volume v;
-    v.geometry.size = Eigen::Vector3i(24, 40, 40);
+    v.geometry.size = size;
     v.geometry.spacing = Eigen::Vector3d::Constant(spacing);
-    v.geometry.origin = Eigen::Vector3d(-11.5 * spacing, -19.5 * spacing, -19.5 * spacing);
+    v.geometry.origin = -0.5 * spacing * (size.cast<double>() - Eigen::Vector3d::Ones());
     v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise_hu(0.0, noise);
-    for (int k = 0; k < 40; ++k)
-      for (int j = 0; j < 40; ++j)
-        for (int i = 0; i < 24; ++i)
+    for (int k = 0; k < size.z(); ++k)
+      for (int j = 0; j < size.y(); ++j)
+        for (int i = 0; i < size.x(); ++i)
           v.at(i, j, k) = static_cast<float>(voxel(v.geometry.toPhysical(Eigen::Vector3d(i, j, k))) + noise_hu(rng));
     return v;
   }
 };
+
+/// Lines across the plane at many places, each started on the steepest
+/// fall as the mesh stage starts them (`starts`: that fall's offset).
+std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed, std::vector<double>& starts) {
+  const imaging::Volume v = c.volume(seed);
+  const Eigen::Vector3d u = c.n;
+  std::vector<imaging::LineVoxels> lines;
+  for (double a = -8; a <= 8; a += 1.0)
+    for (double b = -8; b <= 8; b += 1.0) {
+      const Eigen::Vector3d p = (a + 0.13) * c.across1 + (b - 0.29) * c.across2;
+      const Eigen::Vector3d x0 = p - (u.dot(p) - c.surface) * u;  // on the surface
+      const imaging::Edge edge = imaging::locateEdge(v, x0, u, {});
+      if (!edge.found) continue;
+      starts.push_back(edge.offset_mm);
+      lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm,
+                                               imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry)));
+    }
+  return lines;
+}
+
+/// The mean surface of `lines` by the model with `spread` (their starts added).
+double meanModelSurface(const std::vector<imaging::LineVoxels>& lines, const std::vector<double>& starts,
+                        const imaging::PointSpread& spread, int& found) {
+  double sum = 0;
+  found = 0;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const imaging::CortexFit f = imaging::fitCortex(lines[i], 0.0, spread.along(lines[i]));
+    if (!f.found) continue;
+    sum += starts[i] + f.offset_mm;
+    ++found;
+  }
+  return sum / std::max(found, 1);
+}
 
 struct Estimate {
   imaging::PointSpread spread;
@@ -61,34 +97,15 @@ struct Estimate {
   int found = 0;
 };
 
-/// Lines across the plane at many places, started on the steepest fall as
-/// the mesh stage starts them; the point-spread estimated over them; each
-/// line's surface by the model with it.
+/// The point-spread estimated over lines across the plane; each line's
+/// surface by the model with it.
 Estimate measure(const FlatCortex& c, unsigned seed) {
-  const imaging::Volume v = c.volume(seed);
-  const Eigen::Vector3d u = c.n;
-  std::vector<imaging::LineVoxels> lines;
   std::vector<double> starts;
+  const std::vector<imaging::LineVoxels> lines = linesAcross(c, seed, starts);
   Estimate e;
-  for (double y = -8; y <= 8; y += 1.0)
-    for (double z = -8; z <= 8; z += 1.0) {
-      const Eigen::Vector3d p(0, y + 0.13, z - 0.29);
-      const Eigen::Vector3d x0 = p - (c.n.dot(p) - c.surface) * c.n;  // on the surface
-      const imaging::Edge edge = imaging::locateEdge(v, x0, u, {});
-      if (!edge.found) continue;
-      starts.push_back(edge.offset_mm);
-      lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm,
-                                               imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry)));
-    }
   e.spread = imaging::estimatePointSpread(lines);
-  for (size_t i = 0; i < lines.size(); ++i) {
-    e.mean_steepest += starts[i] / static_cast<double>(lines.size());
-    const imaging::CortexFit f = imaging::fitCortex(lines[i], 0.0, e.spread.sigma_mm);
-    if (!f.found) continue;
-    e.mean_model += starts[i] + f.offset_mm;
-    ++e.found;
-  }
-  e.mean_model /= std::max(e.found, 1);
+  for (const double start : starts) e.mean_steepest += start / static_cast<double>(starts.size());
+  e.mean_model = meanModelSurface(lines, starts, e.spread, e.found);
   return e;
 }
 
@@ -113,6 +130,48 @@ TEST(CortexEdge, ThickCortexAndCoarseVoxels) {
   ASSERT_TRUE(e.spread.found);
   EXPECT_NEAR(e.spread.sigma_mm, thick.sigma, 0.05);
   EXPECT_NEAR(e.mean_model, 0.0, 0.05);
+}
+
+// A CT's slices blur more across than within them: three planes facing
+// within the slices, across them and in between, each blurred by the
+// Gaussian's spread along its normal (0.4 mm within, 0.8 mm across). Both
+// widths come from the lines together, and each plane's surface is found.
+TEST(CortexEdge, WiderPointSpreadAcrossTheSlices) {
+  constexpr double kWithin = 0.4, kAcross = 0.8;
+  std::vector<FlatCortex> planes(3);
+  planes[0].n = Eigen::Vector3d(1, 0.21, -0.13).normalized();
+  planes[1].n = Eigen::Vector3d(0.13, -0.2, 1).normalized();
+  planes[2].n = Eigen::Vector3d(0.7, 0.1, 0.7).normalized();
+  std::vector<imaging::LineVoxels> lines;
+  std::vector<double> starts;
+  std::vector<size_t> first;
+  unsigned seed = 11;
+  for (FlatCortex& plane : planes) {
+    const double across = plane.n.z() * plane.n.z();
+    plane.sigma = std::sqrt(kWithin * kWithin * (1 - across) + kAcross * kAcross * across);
+    plane.thickness = 1.2;
+    plane.spacing = 0.6;
+    plane.size = Eigen::Vector3i::Constant(40);
+    plane.across1 = plane.n.unitOrthogonal();
+    plane.across2 = plane.n.cross(plane.across1);
+    first.push_back(lines.size());
+    const auto more = linesAcross(plane, seed++, starts);
+    lines.insert(lines.end(), more.begin(), more.end());
+  }
+  first.push_back(lines.size());
+  const imaging::PointSpread spread = imaging::estimatePointSpread(lines);
+  ASSERT_TRUE(spread.found);
+  EXPECT_NEAR(spread.sigma_mm, kWithin, 0.05);
+  EXPECT_NEAR(spread.slice_sigma_mm, kAcross, 0.08);
+  for (size_t p = 0; p < planes.size(); ++p) {
+    const std::vector<imaging::LineVoxels> own(lines.begin() + static_cast<long>(first[p]),
+                                               lines.begin() + static_cast<long>(first[p + 1]));
+    const std::vector<double> own_starts(starts.begin() + static_cast<long>(first[p]),
+                                         starts.begin() + static_cast<long>(first[p + 1]));
+    int found = 0;
+    EXPECT_NEAR(meanModelSurface(own, own_starts, spread, found), 0.0, 0.06) << "plane " << p;
+    EXPECT_GT(found, 200) << "plane " << p;
+  }
 }
 
 TEST(CortexEdge, NothingFoundWithoutABrightLayerOrVoxels) {

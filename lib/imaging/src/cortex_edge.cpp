@@ -16,6 +16,9 @@ constexpr double kSearchMm = 1.0;        // the surface is sought this far eithe
 constexpr double kMinThicknessMm = 0.1, kMaxThicknessMm = 4.0;
 constexpr double kMinGapMm = 0.8, kMaxGapMm = 4.0;  // the narrowest joint gaps are about 1.5 mm
 constexpr int kMinLines = 30;
+constexpr double kMinAcrossShare = 0.1;  // of the lines' summed slice share, for a slice width of its own
+constexpr double kWidthRange = 2.5;      // each width within this factor of the common one
+constexpr int kWidthRounds = 2;
 
 double Phi(double z) { return 0.5 * std::erfc(-z * M_SQRT1_2); }
 
@@ -77,6 +80,26 @@ double sumSquares(unsigned, const double* p, double*, void* data) {
   return fitLevels(*o->line, p[0], p[1], p[2], o->sigma).sum_squares;
 }
 
+/// The least of a function unimodal on [a, b], to 0.004 mm: one bracketed
+/// variable, a few hundred fits an evaluation; written out here (a dozen
+/// lines) rather than set up as another NLopt problem.
+template <class F>
+double goldenMinimum(F f, double a, double b) {
+  constexpr double kInvPhi = 0.6180339887498949, kTolerance = 0.004;
+  double c = b - kInvPhi * (b - a), d = a + kInvPhi * (b - a);
+  double fc = f(c), fd = f(d);
+  while (b - a > kTolerance) {
+    if (fc < fd) {
+      b = d, d = c, fd = fc;
+      c = b - kInvPhi * (b - a), fc = f(c);
+    } else {
+      a = c, c = d, fc = fd;
+      d = a + kInvPhi * (b - a), fd = f(d);
+    }
+  }
+  return 0.5 * (a + b);
+}
+
 }  // namespace
 
 double lineRadiusFor(const ImageGeometry& geometry) {
@@ -93,6 +116,8 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
     const double along = g.spacing[a] * g.direction.col(a).dot(u);
     line.box_variance_mm2 += along * along / 12.0;
   }
+  const double across_slices = g.direction.col(2).dot(u);
+  line.slice_share = across_slices * across_slices;
   // The index box around the segment, widened by the radius.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
   for (const double s : {from_mm, to_mm}) {
@@ -156,13 +181,22 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines) {
   PointSpread ps;
   ps.profiles = static_cast<int>(lines.size());
   if (lines.size() < static_cast<size_t>(kMinLines)) return ps;
-  // Summed over the same lines at every sigma; a line found at no sigma adds its
-  // fit anyway (its residual still tells how well that sigma explains it).
-  const auto total = [&](double sigma) {
+  // Summed over the same lines at every width; a line found at no width adds
+  // its fit anyway (its residual still tells how well that width explains it).
+  // Each line's noise is its own (its misfit too): n log(residual) per line.
+  const auto profileLogLikelihood = [](const LineVoxels& line, double sigma) {
+    constexpr double kLeastSumSquares = 1e-9;  // a noiseless line
+    return static_cast<double>(line.offset_mm.size()) *
+           std::log(std::max(fitCortex(line, 0.0, sigma, 0.0).sum_squares, kLeastSumSquares));
+  };
+  const auto total = [&](double in_plane, double across) {
+    PointSpread trial;
+    trial.sigma_mm = in_plane;
+    trial.slice_sigma_mm = across;
     std::vector<double> each(lines.size());
     parallelFor(static_cast<std::ptrdiff_t>(lines.size()), 8, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
-        each[i] = fitCortex(lines[i], 0.0, sigma, 0.0).sum_squares;
+        each[i] = profileLogLikelihood(lines[i], trial.along(lines[i]));
     });
     double sum = 0;
     for (const double e : each) sum += e;  // in order: the same sum for any thread count
@@ -171,27 +205,28 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines) {
   constexpr double kStep = 0.1, kFirst = 0.05, kLast = 2.0;
   for (double s = kFirst; s <= kLast + 1e-9; s += kStep) {
     ps.grid_mm.push_back(s);
-    ps.sum_squares.push_back(total(s));
+    ps.log_likelihood.push_back(total(s, s));
   }
-  const auto at = std::min_element(ps.sum_squares.begin(), ps.sum_squares.end()) - ps.sum_squares.begin();
+  const auto at = std::min_element(ps.log_likelihood.begin(), ps.log_likelihood.end()) - ps.log_likelihood.begin();
   if (at == 0 || at + 1 == static_cast<long>(ps.grid_mm.size())) return ps;
-  // Refined by a golden-section search between the grid's neighbours of the
-  // least: one bracketed variable, 300 fits an evaluation; written out here
-  // (ten lines) rather than set up as another NLopt problem.
-  constexpr double kInvPhi = 0.6180339887498949;
-  double a = ps.grid_mm[static_cast<size_t>(at) - 1], b = ps.grid_mm[static_cast<size_t>(at) + 1];
-  double c = b - kInvPhi * (b - a), d = a + kInvPhi * (b - a);
-  double fc = total(c), fd = total(d);
-  while (b - a > 0.004) {
-    if (fc < fd) {
-      b = d, d = c, fd = fc;
-      c = b - kInvPhi * (b - a), fc = total(c);
-    } else {
-      a = c, c = d, fc = fd;
-      d = a + kInvPhi * (b - a), fd = total(d);
-    }
+  const double common = goldenMinimum([&](double s) { return total(s, s); }, ps.grid_mm[static_cast<size_t>(at) - 1],
+                                      ps.grid_mm[static_cast<size_t>(at) + 1]);
+  ps.sigma_mm = ps.slice_sigma_mm = common;
+  // Then the two widths in turn, each within a factor of 2.5 of the common
+  // one. The slice width needs lines across the slices: where fewer than a
+  // tenth of the lines' spread runs across them, it stays at the common one.
+  double across_share = 0;
+  for (const LineVoxels& line : lines) across_share += line.slice_share;
+  if (across_share < kMinAcrossShare * static_cast<double>(lines.size())) {
+    ps.found = true;
+    return ps;
   }
-  ps.sigma_mm = 0.5 * (a + b);
+  for (int round = 0; round < kWidthRounds; ++round) {
+    ps.slice_sigma_mm = goldenMinimum([&](double s) { return total(ps.sigma_mm, s); }, common / kWidthRange,
+                                      common * kWidthRange);
+    ps.sigma_mm = goldenMinimum([&](double s) { return total(s, ps.slice_sigma_mm); }, common / kWidthRange,
+                                common * kWidthRange);
+  }
   ps.found = true;
   return ps;
 }

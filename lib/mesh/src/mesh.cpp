@@ -218,6 +218,11 @@ void EdgeSnapOptions::validate() const {
   if (smoothing_passes < 0 || smoothing_passes > 100) throw UsageError("edge smoothing passes: expected 0 to 100");
   if (!(point_spread_mm >= 0 && point_spread_mm <= 3))
     throw UsageError("point-spread: expected 0 (estimate) to 3 mm, found " + std::to_string(point_spread_mm));
+  if (!(slice_point_spread_mm >= 0 && slice_point_spread_mm <= 3))
+    throw UsageError("slice point-spread: expected 0 (as within the slices) to 3 mm, found " +
+                     std::to_string(slice_point_spread_mm));
+  if (slice_point_spread_mm > 0 && point_spread_mm <= 0)
+    throw UsageError("slice point-spread: give the point-spread within the slices too (--point-spread)");
 }
 
 namespace {
@@ -286,25 +291,29 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   std::vector<Eigen::Index> on_edge;
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
     if (found[static_cast<size_t>(v)]) on_edge.push_back(v);
-  double sigma = options.point_spread_mm;
-  if (sigma <= 0) {
+  imaging::PointSpread spread;
+  spread.sigma_mm = options.point_spread_mm;
+  spread.slice_sigma_mm = options.slice_point_spread_mm > 0 ? options.slice_point_spread_mm : options.point_spread_mm;
+  if (options.point_spread_mm <= 0) {
     std::vector<imaging::LineVoxels> lines;
     const size_t stride = std::max<size_t>(1, on_edge.size() / kPointSpreadLines);
     for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i]));
-    const imaging::PointSpread ps = imaging::estimatePointSpread(lines);
-    if (!ps.found) {
-      s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(ps.profiles) +
+    spread = imaging::estimatePointSpread(lines);
+    if (!spread.found) {
+      s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(spread.profiles) +
                             " edges; the edges are the steepest falls";
       return;
     }
-    sigma = ps.sigma_mm;
     s.point_spread_estimated = true;
   }
-  s.point_spread_mm = sigma;
+  s.point_spread_mm = spread.sigma_mm;
+  s.slice_point_spread_mm = spread.slice_sigma_mm;
   std::vector<imaging::CortexFit> fits(on_edge.size());
   parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
-    for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
-      fits[i] = imaging::fitCortex(lineAt(on_edge[i]), 0.0, sigma, options.min_contrast_hu);
+    for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
+      const imaging::LineVoxels line = lineAt(on_edge[i]);
+      fits[i] = imaging::fitCortex(line, 0.0, spread.along(line), options.min_contrast_hu);
+    }
   });
   double moved = 0;
   for (size_t i = 0; i < on_edge.size(); ++i) {

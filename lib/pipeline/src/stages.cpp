@@ -17,7 +17,7 @@ const std::vector<StageDescription>& stages() {
       // The CT too: the surface moves onto its bone edge (sub-voxel).
       {"mesh",
        "Marching cubes and smoothing of the label, moved onto the CT's bone edge",
-       {"series-uid", "smoothing", "smooth-iterations", "relaxation", "decimate", "edge-model", "point-spread"},
+       {"series-uid", "smoothing", "smooth-iterations", "relaxation", "decimate", "edge-model", "point-spread", "slice-point-spread"},
        {"label.nii.gz", "CT"},
        {"bone.vtp"},
        {"-i", "{folder}/label.nii.gz", "-o", "{folder}/bone.vtp", "--ct", "{CT}"}},

@@ -11,9 +11,11 @@
 // voxel's own extent along the line, fitted to the voxel values about the
 // line (not to an interpolated profile, whose linear interpolation would be
 // a second, phase-dependent kernel). A thin cortex trades its thickness
-// against the blur within one profile, so the scanner's point-spread is
-// estimated once over many profiles of the same CT (estimatePointSpread)
-// and then held fixed for every line.
+// against the blur within one profile, so the scanner's point-spread (a
+// Gaussian, wider across the slices than within them) is estimated once
+// over many profiles of the same CT (estimatePointSpread) and then held
+// fixed for every line, at its width along that line.
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -30,6 +32,7 @@ namespace articula::imaging {
 struct LineVoxels {
   std::vector<double> offset_mm, value_hu;
   double box_variance_mm2 = 0;  // the voxel's extent along u, as a variance (partial volume)
+  double slice_share = 0;       // (u . slice axis)^2: how far the line runs across the slices
 };
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
                            double to_mm, double radius_mm, double curvature_per_mm = 0);
@@ -57,17 +60,32 @@ struct CortexFit {
 /// `min_contrast_hu` above the outside) or the surface at the search's end.
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
 
+/// The scanner's Gaussian point-spread (standard deviations): one width
+/// within the slices and one across them (a CT's slice profile is commonly
+/// twice as wide as its in-plane blur).
 struct PointSpread {
   bool found = false;
-  double sigma_mm = 0;    // the scanner's Gaussian point-spread (standard deviation)
-  int profiles = 0;       // lines it was estimated on
-  std::vector<double> grid_mm, sum_squares;  // the summed residuals over the lines, by sigma
+  double sigma_mm = 0;        // within the slices
+  double slice_sigma_mm = 0;  // across them (along the slice axis, the grid's third index)
+  int profiles = 0;           // lines it was estimated on
+  std::vector<double> grid_mm, log_likelihood;  // the summed profile log-likelihood (negated) over the grid, one width for both
+  /// The width along a line: the Gaussian's spread in its direction.
+  double along(const LineVoxels& line) const {
+    return std::sqrt(sigma_mm * sigma_mm * (1 - line.slice_share) + slice_sigma_mm * slice_sigma_mm * line.slice_share);
+  }
 };
 
-/// The one point-spread that lets the blurred-cortex model fit `lines`
-/// (each centred on its edge's first guess) best: the least summed residual over sigma,
-/// refined by a parabola. Not found with fewer than 30 lines or when the
-/// least lies at the end of the range searched (0.05-2 mm).
+/// The point-spread that lets the blurred-cortex model fit `lines` (each
+/// centred on its edge's first guess) best, by the profile likelihood of
+/// the widths: each line's residual after its own fit, on a log scale (a
+/// line the model cannot explain, a socket's rim or a cut through the bone,
+/// weighs no more than one it fits; summed residuals let such lines pull
+/// the width). First one width for both directions (a grid over 0.05-2 mm,
+/// then a golden-section search), then each width in turn with the other
+/// held, within a factor 2.5 of the first. Not found with fewer than 30
+/// lines or when the one width's least lies at the end of its range. Lines
+/// that hardly cross the slices (their shares summing to less than a tenth
+/// of the lines) give one width for both.
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
 
 }  // namespace articula::imaging

@@ -55,9 +55,10 @@ struct EdgeSnapOptions {
   /// an estimate a few hundredths of a millimetre off moves it about three
   /// times as far (docs/benchmarks.md, "Blurred-cortex edges").
   bool cortex_model = false;
-  /// The scanner's Gaussian point-spread for the model, mm (0: estimated
-  /// from the CT's own edges).
-  double point_spread_mm = 0;
+  /// The scanner's Gaussian point-spread for the model, mm, within the
+  /// slices and across them (0: both estimated from the CT's own edges;
+  /// the slice width 0: as within the slices).
+  double point_spread_mm = 0, slice_point_spread_mm = 0;
   /// Throws UsageError naming the first invalid option.
   void validate() const;
 };
@@ -71,7 +72,7 @@ struct EdgeSnapSummary {
   /// it used (estimated or given; 0 when none), the vertices it placed and
   /// their mean shift from the steepest fall (negative: inwards).
   bool cortex_model = false;
-  double point_spread_mm = 0;
+  double point_spread_mm = 0, slice_point_spread_mm = 0;  // within the slices, across them
   bool point_spread_estimated = false;
   long long on_cortex_model = 0;
   double mean_model_shift_mm = 0;
