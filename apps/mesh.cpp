@@ -40,8 +40,9 @@ class MeshCommand : public cli::Command {
     app.add_option("--edge-model", edge_model_,
                    "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
                    "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
-                   "the voxels about the normal, with one point-spread for the CT")
-        ->check(CLI::IsMember({"cortex", "steepest"}))
+                   "the voxels about the normal, with one point-spread for the CT; 'auto' the cortex model on CTs "
+                   "whose voxels are at most 0.8 mm on every side, the steepest fall beyond")
+        ->check(CLI::IsMember({"auto", "cortex", "steepest"}))
         ->capture_default_str();
     app.add_option("--point-spread", snap_.point_spread_mm,
                    "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation) within "
@@ -66,7 +67,9 @@ class MeshCommand : public cli::Command {
       throw UsageError("--output: expected a .vtp, .stl or .ply file, found '" + output_.string() + "'");
     if (!common.force && std::filesystem::exists(output_))
       throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
-    snap_.cortex_model = edge_model_ == "cortex";
+    snap_.edge_model = edge_model_ == "cortex"     ? mesh::EdgeModel::Cortex
+                       : edge_model_ == "steepest" ? mesh::EdgeModel::SteepestFall
+                                                   : mesh::EdgeModel::Automatic;
     snap_.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
     checkOutputTarget(output_);
@@ -128,7 +131,7 @@ class MeshCommand : public cli::Command {
 
  private:
   std::filesystem::path input_, output_, ct_;
-  std::string smoothing_ = "laplacian", series_uid_, edge_model_ = "steepest";
+  std::string smoothing_ = "laplacian", series_uid_, edge_model_ = "auto";
   mesh::EdgeSnapOptions snap_;
   bool all_components_ = false;
   mesh::MeshOptions options_;

@@ -368,7 +368,10 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
       neighbours[static_cast<size_t>(a)].push_back(b);
       neighbours[static_cast<size_t>(b)].push_back(a);
     }
-  if (options.cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
+  const bool cortex_model =
+      options.edge_model == EdgeModel::Cortex ||
+      (options.edge_model == EdgeModel::Automatic && ct.geometry.spacing.maxCoeff() <= kCortexModelMaxVoxelMm + 1e-6);
+  if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
   // Neighbour averages over the triangles' edges: the found shifts smoothed,
   // the others taken from found neighbours (repeatedly, as far as the passes reach).
   const int passes = std::max(options.smoothing_passes, 1);

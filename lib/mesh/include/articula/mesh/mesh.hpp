@@ -43,18 +43,28 @@ struct MeshSummary {
 /// outward normals. Throws InputError if the label has no voxel set.
 TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& options, MeshSummary* summary = nullptr);
 
+enum class EdgeModel { Automatic, SteepestFall, Cortex };
+
+/// The coarsest voxel (its longest side, mm) on which the automatic edge
+/// model is the blurred-cortex model. Up to it the model's point-spread,
+/// estimated from the CT, put every head of the phantom matrix within
+/// 0.04 mm of its true surface, thin cortices included (the steepest fall:
+/// up to 0.2 mm outside); at 1 x 1 x 1.25 mm it took one CT's point-spread
+/// 0.1 mm wide and the surface 0.2 mm inside, where the steepest fall errs
+/// by less than 0.1 mm (docs/benchmarks.md, "Blurred-cortex edges").
+constexpr double kCortexModelMaxVoxelMm = 0.8;
+
 struct EdgeSnapOptions {
   double search_mm = 0;         // edge search either side of a vertex (0: 1.5 voxels inwards, at least 1.5 mm; a quarter voxel outwards, at least 0.75 mm)
   double min_contrast_hu = 150; // least fall across an edge (see imaging/edges.hpp)
   double min_inside_hu = 200;   // the bone side of an edge reaches at least this
   int smoothing_passes = 2;     // neighbour averages of the shifts (CT noise)
-  /// Each steepest fall moved onto the outer surface of a blurred-cortex
-  /// model fitted to the voxels about the normal (imaging/cortex_edge.hpp),
-  /// which a thin cortex does not pull outwards. Off by default: the
-  /// surface then rests on the point-spread estimated from the same CT, and
-  /// an estimate a few hundredths of a millimetre off moves it about three
-  /// times as far (docs/benchmarks.md, "Blurred-cortex edges").
-  bool cortex_model = false;
+  /// Where the edge is put: on the steepest fall, or moved from it onto the
+  /// outer surface of a blurred-cortex model fitted to the voxels about the
+  /// normal (imaging/cortex_edge.hpp), which a thin cortex does not pull
+  /// outwards; Automatic: the model on CTs whose voxels are at most
+  /// kCortexModelMaxVoxelMm on every side, the steepest fall beyond.
+  EdgeModel edge_model = EdgeModel::Automatic;
   /// The scanner's Gaussian point-spread for the model, mm, within the
   /// slices and across them (0: both estimated from the CT's own edges;
   /// the slice width 0: as within the slices).
@@ -82,7 +92,7 @@ struct EdgeSnapSummary {
 /// Moves every vertex along its normal onto the CT's bone edge (the
 /// steepest HU fall, imaging::locateEdge; where the window holds none, the
 /// first fall going out through bone, within 3 mm, for voxels up to 2 mm;
-/// with cortex_model, the outer surface of the blurred-cortex model), so that the surface lies where
+/// with the cortex model, the outer surface of the blurred cortex), so that the surface lies where
 /// the cortex meets soft tissue at sub-voxel precision and not where the
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours.
