@@ -61,8 +61,8 @@ struct CortexFit {
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
 
 /// The scanner's Gaussian point-spread (standard deviations): one width
-/// within the slices and one across them (a CT's slice profile is commonly
-/// twice as wide as its in-plane blur).
+/// within the slices and one across them (a CT's slice profile is often
+/// wider than its in-plane blur).
 struct PointSpread {
   bool found = false;
   double sigma_mm = 0;        // within the slices
