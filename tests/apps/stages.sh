@@ -56,7 +56,7 @@ PY
 # a policy that forbids requests),
 # its numbers those of results.json, both error figures inline.
 python3 - "$tmp/r/report.html" "$tmp/r/results.json" <<'PY'
-import json, re, sys
+import json, os, re, sys
 html, r = open(sys.argv[1]).read(), json.load(open(sys.argv[2]))
 assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
 assert not re.search(r'<(link|img|iframe)\b|<script[^>]*\bsrc\b', html), "external content"
@@ -92,9 +92,26 @@ assert 'class="status %s"' % r["qc"]["status"] in html
 assert html.count("<svg") >= 2, "the error figures are not inline"
 methods = re.search(r'<p id="methods">(.*?)</p>', html, re.S).group(1)
 assert "The %s was selected" % selected in methods and r["provenance"]["git_commit"] in methods, methods
+# The methods name the edge model the mesh stage used.
+edges = json.load(open(os.path.join(os.path.dirname(sys.argv[2]), "bone.vtp.json")))["ct_edges"]
+assert ("blurred-cortex model" in methods) == (edges["edge_model"] == "cortex"), methods
+assert "steepest fall" in methods, methods
 PY
 expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force --selection-floor 1
 grep -q '"selected_model": "sphere"' "$tmp/r/results.json" || fail "--selection-floor 1 should select the sphere"
+
+# With the blurred-cortex edges (the default on voxels up to 0.8 mm; asked
+# for here), the methods say so, with the point-spread the mesh stage used.
+expect_rc 0 "$bin/articula-mesh" -i "$tmp/r/label.nii.gz" -o "$tmp/r/bone.vtp" --ct "$ct" --edge-model cortex --force
+expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
+python3 - "$tmp/r/report.html" "$tmp/r/bone.vtp.json" <<'PY'
+import json, re, sys
+methods = re.search(r'<p id="methods">(.*?)</p>', open(sys.argv[1]).read(), re.S).group(1)
+edges = json.load(open(sys.argv[2]))["ct_edges"]
+assert edges["edge_model"] == "cortex" and edges["point_spread_estimated"], edges
+assert "blurred-cortex model" in methods and "estimated from the CT: %.2f mm within the slices and %.2f mm across" % (
+    edges["point_spread_mm"], edges["slice_point_spread_mm"]) in methods, methods
+PY
 
 # A missing stage output: exit 3, named; nothing written.
 mkdir -p "$tmp/r2/errors"

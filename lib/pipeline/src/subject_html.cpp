@@ -149,7 +149,16 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
       << fixed(segment.at("spacing_mm")[1].get<double>(), 2) << " x " << fixed(segment.at("spacing_mm")[2].get<double>(), 2)
       << " mm";
   p << "; its surface was extracted by marching cubes and smoothing";
-  if (member(member(mesh, "ct_edges"), "moved") == true) p << " and moved onto the CT's bone edge (the steepest fall of the HU profile, sub-voxel)";
+  const json& edges = member(mesh, "ct_edges");
+  if (member(edges, "moved") == true) {
+    p << " and moved onto the CT's bone edge (sub-voxel: the steepest fall of the HU profile along each normal";
+    if (text(edges, "edge_model") == "cortex")
+      p << ", then the outer surface of a blurred-cortex model fitted to the voxels about it, with the scanner's "
+        << "Gaussian point-spread " << (member(edges, "point_spread_estimated") == true ? "estimated from the CT" : "given")
+        << ": " << fixed(numberAt(edges, "point_spread_mm"), 2) << " mm within the slices and "
+        << fixed(numberAt(edges, "slice_point_spread_mm"), 2) << " mm across them";
+    p << ")";
+  }
   p << ". The articular surface was selected and down-sampled to ";
   const json* m = modelNamed(results, selected);
   const double n_points = m ? numberAt(member(*m, "errors"), "n_points") : NAN;
