@@ -203,14 +203,16 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines) {
     return sum;
   };
   constexpr double kStep = 0.1, kFirst = 0.05, kLast = 2.0;
+  std::vector<double> grid_mm, negated_log_likelihood;
   for (double s = kFirst; s <= kLast + 1e-9; s += kStep) {
-    ps.grid_mm.push_back(s);
-    ps.log_likelihood.push_back(total(s, s));
+    grid_mm.push_back(s);
+    negated_log_likelihood.push_back(total(s, s));
   }
-  const auto at = std::min_element(ps.log_likelihood.begin(), ps.log_likelihood.end()) - ps.log_likelihood.begin();
-  if (at == 0 || at + 1 == static_cast<long>(ps.grid_mm.size())) return ps;
-  const double common = goldenMinimum([&](double s) { return total(s, s); }, ps.grid_mm[static_cast<size_t>(at) - 1],
-                                      ps.grid_mm[static_cast<size_t>(at) + 1]);
+  const auto at = std::min_element(negated_log_likelihood.begin(), negated_log_likelihood.end()) -
+                  negated_log_likelihood.begin();
+  if (at == 0 || at + 1 == static_cast<long>(grid_mm.size())) return ps;
+  const double common = goldenMinimum([&](double s) { return total(s, s); }, grid_mm[static_cast<size_t>(at) - 1],
+                                      grid_mm[static_cast<size_t>(at) + 1]);
   ps.sigma_mm = ps.slice_sigma_mm = common;
   // Then the two widths in turn, each within a factor of 2.5 of the common
   // one. The slice width needs lines across the slices: where fewer than a

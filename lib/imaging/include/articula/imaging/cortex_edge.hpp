@@ -68,7 +68,6 @@ struct PointSpread {
   double sigma_mm = 0;        // within the slices
   double slice_sigma_mm = 0;  // across them (along the slice axis, the grid's third index)
   int profiles = 0;           // lines it was estimated on
-  std::vector<double> grid_mm, log_likelihood;  // the summed profile log-likelihood (negated) over the grid, one width for both
   /// The width along a line: the Gaussian's spread in its direction.
   double along(const LineVoxels& line) const {
     return std::sqrt(sigma_mm * sigma_mm * (1 - line.slice_share) + slice_sigma_mm * slice_sigma_mm * line.slice_share);
