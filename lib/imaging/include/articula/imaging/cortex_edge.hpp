@@ -55,9 +55,11 @@ struct CortexFit {
 
 /// The blurred-cortex model fitted to `line` with the scanner's Gaussian
 /// point-spread `sigma_mm` (the voxel's extent is added), the surface
-/// searched within 1 mm of `guess_mm`. Not found when the fit puts no
-/// bright layer on the bone side (cortex or bone at least
-/// `min_contrast_hu` above the outside) or the surface at the search's end.
+/// searched within 1 mm of `guess_mm`. Where the voxels rise again beyond
+/// the edge (a socket across a joint gap), the window ends within that rise.
+/// Not found when the fit puts no bright layer on the bone side (cortex or
+/// bone at least `min_contrast_hu` above the outside) or the surface at the
+/// search's end.
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
 
 /// The scanner's Gaussian point-spread (standard deviations): one width
@@ -81,7 +83,8 @@ struct PointSpread {
 /// weighs no more than one it fits; summed residuals let such lines pull
 /// the width). First one width for both directions (a grid over 0.05-2 mm,
 /// then a golden-section search), then each width in turn with the other
-/// held, within a factor 2.5 of the first. Not found with fewer than 30
+/// held, within a factor 2.5 of the first. Lines that face a socket are
+/// left out while 30 others remain. Not found with fewer than 30
 /// lines or when the one width's least lies at the end of its range. Lines
 /// that hardly cross the slices (their shares summing to less than a tenth
 /// of the lines) give one width for both.
