@@ -79,15 +79,15 @@ struct Objective {
   const LineVoxels* line = nullptr;
   double sigma = 0;
   double best = std::numeric_limits<double>::infinity();
-  std::vector<double> best_point;
+  std::array<double, 3> best_point{};
 };
 
-double sumSquares(unsigned n, const double* p, double*, void* data) {
+double sumSquares(unsigned, const double* p, double*, void* data) {
   auto* o = static_cast<Objective*>(data);
   const double value = fitLevels(*o->line, p[0], p[1], p[2], o->sigma).sum_squares;
   if (value < o->best) {
     o->best = value;
-    o->best_point.assign(p, p + n);
+    o->best_point = {p[0], p[1], p[2]};
   }
   return value;
 }
@@ -216,7 +216,8 @@ CortexFit fitCortex(const LineVoxels& whole_line, double guess_mm, double sigma_
   // moves out (0.13-0.16 mm for a 0.8 mm cortex 1.5-2 mm away under 0.5 mm
   // of blur). The window ends in the socket's rise instead.
   const SocketInWindow socket = socketInWindow(whole_line);
-  const LineVoxels line = socket.found ? upTo(whole_line, socket.window_end_mm) : whole_line;
+  const LineVoxels near = socket.found ? upTo(whole_line, socket.window_end_mm) : LineVoxels{};
+  const LineVoxels& line = socket.found ? near : whole_line;  // no copy of a line without a socket
   if (line.offset_mm.size() < 12 || !(sigma_mm > 0)) return fit;
   Objective objective;
   objective.line = &line;
@@ -236,8 +237,8 @@ CortexFit fitCortex(const LineVoxels& whole_line, double guess_mm, double sigma_
   } catch (const std::exception&) {
     // Only the search's end is lost: its best point stands.
   }
-  if (objective.best_point.empty()) return fit;  // not one residual was evaluated
-  p = objective.best_point;
+  if (!std::isfinite(objective.best)) return fit;  // not one finite residual was evaluated
+  p.assign(objective.best_point.begin(), objective.best_point.end());
   const Levels l = fitLevels(line, p[0], p[1], p[2], objective.sigma);
   fit.offset_mm = p[0];
   fit.thickness_mm = p[1];
