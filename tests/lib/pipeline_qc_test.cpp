@@ -1,7 +1,8 @@
 // Head checks: a head's cap passes; each wrong structure fails the check
 // made to reveal it (a socket's inner surface, a small trochanter-like
 // blob, a cut cap, a non-spherical patch, a search that found elsewhere,
-// a side the search could not tell, points inside the bone).
+// a side the search could not tell, points inside the bone); a cortex
+// blurred away across the slices warns.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -160,6 +161,61 @@ TEST(HeadQc, PointsInsideTheBoneFailOnTheCtsEdges) {
   EXPECT_EQ(check(r, "points_inside_bone_share").status, "fail");
   EXPECT_EQ(check(r, "points_on_ct_edge_share").status, "fail");
   EXPECT_EQ(r.status, "fail");
+}
+
+/// A head of radius 22 mm about `centre` with a cortex `cortex_mm` thick
+/// (900 HU over 250 HU cancellous bone, 40 HU around), point-sampled on
+/// voxels of `spacing`, blurred along its normal by the Gaussian that an
+/// anisotropic point spread (`sigma_xy` within the slices, `sigma_z` across)
+/// has there: exact for a surface flat over a few sigma.
+imaging::Volume shellHead(const Eigen::Vector3d& centre, double cortex_mm, double sigma_xy, double sigma_z,
+                          const Eigen::Vector3d& spacing) {
+  imaging::Volume v;
+  const double half = 28;
+  v.geometry.spacing = spacing;
+  v.geometry.size = (2 * half / spacing.array()).ceil().cast<int>() + 1;
+  v.geometry.origin = centre - Eigen::Vector3d::Constant(half);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  for (int k = 0; k < v.geometry.size[2]; ++k)
+    for (int j = 0; j < v.geometry.size[1]; ++j)
+      for (int i = 0; i < v.geometry.size[0]; ++i) {
+        const Eigen::Vector3d d = v.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - centre;
+        const double r = d.norm(), nz2 = r > 0 ? d.z() * d.z() / (r * r) : 0;
+        const double s = std::sqrt(sigma_xy * sigma_xy * (1 - nz2) + sigma_z * sigma_z * nz2);
+        v.at(i, j, k) = static_cast<float>(40 + 860 * Phi((22 - r) / s) - 650 * Phi((22 - cortex_mm - r) / s));
+      }
+  return v;
+}
+
+TEST(HeadQc, ACortexBlurredAwayAcrossTheSlicesWarns) {
+  // A 0.7 mm cortex under 2 mm of blur across 2.5 mm slices: its steepest
+  // fall there lies about 1 mm outside. Warned, without failing the head.
+  pipeline::HeadQcInput in = cap(22, 100);
+  const auto contrast = [&](double cortex, double sigma_xy, double sigma_z, const Eigen::Vector3d& spacing) {
+    return pipeline::cortexContrastAcrossSlices(shellHead(in.sphere_center, cortex, sigma_xy, sigma_z, spacing),
+                                                in.points, in.normals);
+  };
+  in.cortex_contrast_across_slices = contrast(0.7, 0.4, 2.0, Eigen::Vector3d(0.7, 0.7, 2.5));
+  ASSERT_TRUE(in.cortex_contrast_across_slices);
+  EXPECT_LT(*in.cortex_contrast_across_slices, 0.15);
+  pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "cortex_contrast_across_slices").status, "warn");
+  EXPECT_EQ(r.status, "warn");
+
+  // The same cortex sharp both ways, on fine voxels; and a 2.5 mm cortex
+  // under 1 mm of blur across 1.25 mm slices: it shows across the slices.
+  in.cortex_contrast_across_slices = contrast(0.7, 0.4, 0.4, Eigen::Vector3d(0.6, 0.6, 0.6));
+  ASSERT_TRUE(in.cortex_contrast_across_slices);
+  EXPECT_GT(*in.cortex_contrast_across_slices, 0.8);
+  EXPECT_EQ(pipeline::checkHead(in).status, "pass");
+  in.cortex_contrast_across_slices = contrast(2.5, 0.4, 1.0, Eigen::Vector3d(0.7, 0.7, 1.25));
+  ASSERT_TRUE(in.cortex_contrast_across_slices);
+  EXPECT_GT(*in.cortex_contrast_across_slices, 0.5);
+  EXPECT_EQ(check(pipeline::checkHead(in), "cortex_contrast_across_slices").status, "pass");
+
+  // No cortex anywhere (cancellous bone to its surface): not measurable.
+  EXPECT_FALSE(contrast(0.0, 0.4, 0.4, Eigen::Vector3d(0.6, 0.6, 0.6)));
 }
 
 TEST(HeadQc, TooFewPointsAreRefused) {

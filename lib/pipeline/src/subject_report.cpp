@@ -96,6 +96,7 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
   if (ct && in.normals.rows() == in.points.rows() &&
       ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
     in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
+  if (ct) in.cortex_contrast_across_slices = cortexContrastAcrossSlices(*ct, in.points, in.normals);
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
   if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");

@@ -7,6 +7,9 @@
 // whether the search could tell the joint's side, and whether the CT shows
 // the bone's edge where the points are (a label cut inside the head, where
 // a faint cortex fell below the bone window, has points inside the bone).
+// One check is of the surface's accuracy, not of the structure: whether
+// the cortex still shows across the slices (where a thin cortex is blurred
+// away there, the edge found lies outside the bone's surface).
 // Each check passes, warns (doubtful) or fails (the result is not a head).
 #include <optional>
 #include <string>
@@ -33,6 +36,7 @@ struct HeadQcInput {
   double search_radius_mm = 0;
   std::optional<bool> side_verified;             // the search's side check, if it searched
   std::optional<PointsOnCtEdge> ct_edges;        // where the CT's bone edge is about the points, if a CT was given
+  std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
 };
 
@@ -54,6 +58,19 @@ struct QcReport {
 /// from 3 mm inside) lies about `points`: the shares of the points within
 /// half a voxel (at least 0.5 mm) of it and inside the bone.
 PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& normals);
+
+/// How much of the cortex's contrast over the cancellous bone survives the
+/// blur across the slices: on lines along the outward normals, the median
+/// of (the highest HU from 3 mm inside to 0.5 mm outside the point, less
+/// the HU 4 mm inside) on lines that cross the slices (|normal . slice
+/// axis| > 0.8), over the same on lines within a slice (< 0.3). About 1
+/// where the cortex is thicker than the blur across the slices; near 0
+/// where it is blurred into the cancellous bone there. Empty where it cannot
+/// be measured: fewer than 20 lines in either group, or a contrast within a
+/// slice below 100 HU (no cortex shows even there). The slice axis is the
+/// voxel axis of the largest spacing (the third on a tie).
+std::optional<double> cortexContrastAcrossSlices(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
+                                                 const Eigen::MatrixX3d& normals);
 
 /// Runs every check that its inputs allow; throws InputError for fewer than 4 points.
 QcReport checkHead(const HeadQcInput& input);
