@@ -81,10 +81,13 @@ def run_ct(ct, bin_dir, work, run_args=()):
             s = subprocess.run([f"{bin_dir}/bench-score-head", f"{d}/ct/truth.json", side, f"{out}/points.ply",
                                 f"{out}/results.json"], check=True, capture_output=True, text=True)
             row.update(json.loads(s.stdout))
-            row["selected"] = json.load(open(f"{out}/results.json")).get("selected_model")
+            results = json.load(open(f"{out}/results.json"))
+            row["selected"] = results.get("selected_model")
+            row["qc"] = results.get("qc", {}).get("status", "")
             limit = 0.5 * min(ct["spacing"][0], ct["spacing"][1])
             ok = row["rms_mm"] <= limit and row["share_within_1p5_mm"] >= 0.95
-            row["verdict"] = "correct" if ok else "SILENTLY WRONG"
+            # Wrong with a warning in results.json and on stderr is flagged, not silent.
+            row["verdict"] = "correct" if ok else "wrong, warned" if row["qc"] == "warn" else "SILENTLY WRONG"
         else:
             row["verdict"] = "refused"
         rows.append(row)
@@ -96,8 +99,8 @@ def fmt(v, spec=".2f"):
 
 
 def table(rows):
-    lines = ["| spacing group | heads | correct | refused | silently wrong | median centre error (mm) | "
-             "median RMS (mm) | median mean signed (mm) |", "|---|---|---|---|---|---|---|---|"]
+    lines = ["| spacing group | heads | correct | refused | wrong, warned | silently wrong | median centre error (mm) | "
+             "median RMS (mm) | median mean signed (mm) |", "|---|---|---|---|---|---|---|---|---|"]
     for group, _ in GROUPS + [("all", None)]:
         g = [r for r in rows if group in ("all", r["group"])]
         if not g:
@@ -105,7 +108,7 @@ def table(rows):
         share = lambda v: f"{100.0 * sum(r['verdict'] == v for r in g) / len(g):.0f} %"
         scored = [r for r in g if r["exit"] == 0]
         med = lambda k: fmt(statistics.median([r[k] for r in scored])) if scored else ""
-        lines.append(f"| {group} | {len(g)} | {share('correct')} | {share('refused')} | {share('SILENTLY WRONG')} | "
+        lines.append(f"| {group} | {len(g)} | {share('correct')} | {share('refused')} | {share('wrong, warned')} | {share('SILENTLY WRONG')} | "
                      f"{med('centre_error_mm')} | {med('rms_mm')} | {med('mean_signed_mm')} |")
     lines += ["", "| case | side | spacing (mm) | input | model | radius (mm) | gap (mm) | socket | bone | fovea | "
               "verdict | exit | centre error (mm) | RMS (mm) | mean signed (mm) | within 1.5 mm | run (s) | message |",

@@ -6,8 +6,9 @@
 # Lorentzian blur, correlated noise, cupping, int16 with slope/intercept,
 # oblique and RAS storage, cropped fields of view with and without air.
 # Each head is correct (articular points' RMS to the true head <= half the
-# in-plane voxel and >= 95 % within 1.5 mm), refused (exit != 0) or SILENTLY
-# WRONG (exit 0, not correct), with the qc status beside it. Prints a
+# in-plane voxel and >= 95 % within 1.5 mm), refused (exit != 0), wrong but
+# warned (exit 0, qc "warn") or SILENTLY WRONG (exit 0, qc "pass", not
+# correct), with the qc status beside it. Prints a
 # markdown table; phantoms are cached in WORK.
 #   bash bench/third_phantoms.sh [build/bin] [WORK] [case-regex]
 set -uo pipefail
@@ -119,7 +120,7 @@ if rc == "0":
     ce = np.linalg.norm(np.array([sel["parameters"][k] for k in ("t1_mm", "t2_mm", "t3_mm")]) - np.array(h["head_center_mm"]))
     d = head_distances(f"{run}/errors/errors.csv", truth, side)
     rms = float(np.sqrt((d ** 2).mean())); within = float((np.abs(d) <= 1.5).mean())
-    verdict = "correct" if rms <= 0.5 * sp[0] and within >= 0.95 else "SILENTLY WRONG"
+    verdict = "correct" if rms <= 0.5 * sp[0] and within >= 0.95 else "wrong, warned" if qc == "warn" else "SILENTLY WRONG"
     cells = [f"{ce:.2f}", f"{d.mean():+.3f}", f"{rms:.3f}", f"{100 * within:.0f} %"]
 else:
     verdict = "refused"
