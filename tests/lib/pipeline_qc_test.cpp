@@ -1,8 +1,9 @@
 // Head checks: a head's cap passes; each wrong structure fails the check
 // made to reveal it (a socket's inner surface, a small trochanter-like
 // blob, a cut cap, a non-spherical patch, a search that found elsewhere,
-// a side the search could not tell, points inside the bone); a cortex
-// blurred away across the slices warns.
+// a side the search could not tell, points inside the bone, a shell label
+// off the CT's edges at coarse voxels); a cortex blurred away across the
+// slices warns.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -216,6 +217,39 @@ TEST(HeadQc, ACortexBlurredAwayAcrossTheSlicesWarns) {
 
   // No cortex anywhere (cancellous bone to its surface): not measurable.
   EXPECT_FALSE(contrast(0.0, 0.4, 0.4, Eigen::Vector3d(0.6, 0.6, 0.6)));
+}
+
+TEST(HeadQc, AShellLabelOffTheCtsEdgesFailsAtCoarseVoxels) {
+  // At 1.5 x 1.5 x 3 mm the CT's edge checks are off, but a label 5 mm
+  // deep for a head of radius 22 mm is a shell, and its points must lie on
+  // the CT's edge: those of the head's surface do; those of a shell cut
+  // 3 mm inside it (the cortex below the bone window) do not.
+  pipeline::HeadQcInput in = cap(22, 80);
+  const imaging::Volume ct = shellHead(in.sphere_center, 1.0, 0.6, 1.2, Eigen::Vector3d(1.5, 1.5, 3.0));
+  in.ct_voxel_mm = 3.0;
+  in.label_depth_mm = 5.0;
+  in.ct_edges = pipeline::pointsOnCtEdge(ct, in.points, in.normals);
+  EXPECT_GT(in.ct_edges->on_edge, 0.9);
+  pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "shell_label_points_on_ct_edge_share").status, "pass");
+  EXPECT_THROW(check(r, "points_on_ct_edge_share"), std::runtime_error) << "off beyond 2 mm voxels";
+  EXPECT_EQ(r.status, "pass");
+
+  pipeline::HeadQcInput cut = cap(19, 80);
+  cut.sphere_center = in.sphere_center;
+  cut.ct_voxel_mm = 3.0;
+  cut.label_depth_mm = 5.0;
+  cut.ct_edges = pipeline::pointsOnCtEdge(ct, cut.points, cut.normals);
+  EXPECT_LT(cut.ct_edges->on_edge, 0.1);
+  r = pipeline::checkHead(cut);
+  EXPECT_EQ(check(r, "shell_label_points_on_ct_edge_share").status, "fail");
+  EXPECT_EQ(r.status, "fail");
+
+  // A solid label (16 mm deep) is not checked so at these voxels.
+  cut.label_depth_mm = 16.0;
+  r = pipeline::checkHead(cut);
+  EXPECT_THROW(check(r, "shell_label_points_on_ct_edge_share"), std::runtime_error);
+  EXPECT_EQ(r.status, "pass");
 }
 
 TEST(HeadQc, TooFewPointsAreRefused) {

@@ -30,6 +30,10 @@ constexpr double kSliceContrastWarn = 0.3;
 constexpr double kSliceAxisShare = 0.8, kInPlaneShare = 0.3;  // |normal . slice axis| of the two groups of lines
 constexpr int kMinLinesPerGroup = 20;
 constexpr double kMinInPlaneContrastHu = 100;
+// A label's depth against its fitted radius: 0.5-0.95 for a solid head
+// (the cut at the neck makes it less than 1); a shell is thinner (0.08-0.28
+// on phantoms and real CTs, correct or not).
+constexpr double kShellDepthRelative = 0.4;
 constexpr int kDoubtsThatFail = 2;                              // warnings of the structure's checks
 
 std::string number(double v) {
@@ -171,7 +175,17 @@ QcReport checkHead(const HeadQcInput& in) {
       report.checks.push_back(grade("search_radius_difference_relative", std::abs(in.search_radius_mm - r) / r, kRadiusWarn,
                                     kRadiusFail, false, "the head search's radius differs from the fitted one, relative:"));
   }
-  if (in.ct_edges) {
+  const bool fine_voxels = in.ct_voxel_mm <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6;
+  if (in.ct_edges && !fine_voxels && in.label_depth_mm && *in.label_depth_mm < kShellDepthRelative * r) {
+    // A shell's outer surface is the bone's only where the CT's edge is
+    // (a thin cortex over faint cancellous bone); a shell cut from within
+    // the bone (the cortex itself below the window) has no edge there.
+    report.checks.push_back(grade("shell_label_points_on_ct_edge_share", in.ct_edges->on_edge, kEdgeWarn, kEdgeFail,
+                                  true, "the label is a shell (" + number(*in.label_depth_mm) +
+                                            " mm deep for a head of radius " + number(r) +
+                                            " mm), and the share of its points on the CT's bone edge is"));
+  }
+  if (in.ct_edges && fine_voxels) {
     report.checks.push_back(grade("points_on_ct_edge_share", in.ct_edges->on_edge, kEdgeWarn, kEdgeFail, true,
                                   "share of the points on the CT's bone edge (within half a voxel):"));
     report.checks.push_back(grade("points_inside_bone_share", in.ct_edges->inside_bone, kInsideWarn, kInsideFail, false,

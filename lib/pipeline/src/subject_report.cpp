@@ -93,10 +93,11 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
-  if (ct && in.normals.rows() == in.points.rows() &&
-      ct->geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6)
+  if (ct && in.normals.rows() == in.points.rows()) {
     in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
-  if (ct) in.cortex_contrast_across_slices = cortexContrastAcrossSlices(*ct, in.points, in.normals);
+    in.ct_voxel_mm = ct->geometry.spacing.maxCoeff();
+    in.cortex_contrast_across_slices = cortexContrastAcrossSlices(*ct, in.points, in.normals);
+  }
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
   if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");
@@ -106,6 +107,7 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);
     try {
+      if (seg.contains("head_depth_mm")) in.label_depth_mm = seg.at("head_depth_mm").get<double>();
       if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
         const auto& sc = seg.at("head_center_mm");
         in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());

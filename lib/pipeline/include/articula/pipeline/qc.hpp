@@ -7,6 +7,9 @@
 // whether the search could tell the joint's side, and whether the CT shows
 // the bone's edge where the points are (a label cut inside the head, where
 // a faint cortex fell below the bone window, has points inside the bone).
+// At coarser voxels, where the CT's edges are checked no more, a label
+// much thinner than its head's radius (a shell: cancellous bone below the
+// bone window) must still have its points on the CT's edge.
 // One check is of the surface's accuracy, not of the structure: whether
 // the cortex still shows across the slices (where a thin cortex is blurred
 // away there, the edge found lies outside the bone's surface).
@@ -36,6 +39,8 @@ struct HeadQcInput {
   double search_radius_mm = 0;
   std::optional<bool> side_verified;             // the search's side check, if it searched
   std::optional<PointsOnCtEdge> ct_edges;        // where the CT's bone edge is about the points, if a CT was given
+  double ct_voxel_mm = 0;                        // the CT's largest spacing: its edge checks apply up to 2 mm
+  std::optional<double> label_depth_mm;          // the segmentation's label: the depth of its deepest voxel
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
 };
