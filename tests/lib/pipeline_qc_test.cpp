@@ -2,8 +2,8 @@
 // made to reveal it (a socket's inner surface, a small trochanter-like
 // blob, a cut cap, a non-spherical patch, a search that found elsewhere,
 // a side the search could not tell, points inside the bone, a shell label
-// off the CT's edges at coarse voxels); a cortex blurred away across the
-// slices warns.
+// off the CT's edges at coarse voxels, a socket's outer surface that faces
+// no socket); a cortex blurred away across the slices warns.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -250,6 +250,57 @@ TEST(HeadQc, AShellLabelOffTheCtsEdgesFailsAtCoarseVoxels) {
   r = pipeline::checkHead(cut);
   EXPECT_THROW(check(r, "shell_label_points_on_ct_edge_share"), std::runtime_error);
   EXPECT_EQ(r.status, "pass");
+}
+
+/// A femoral head of radius 22 mm about `centre` (a 1 mm cortex at 700 HU
+/// over 150 HU), a 2 mm joint gap and a 4 mm acetabular wall (600 HU) over
+/// the head's upper half, in 40 HU soft tissue; blurred radially (0.8 mm),
+/// on voxels of `spacing`.
+imaging::Volume hipWithSocket(const Eigen::Vector3d& centre, const Eigen::Vector3d& spacing) {
+  imaging::Volume v;
+  const double half = 34;
+  v.geometry.spacing = spacing;
+  v.geometry.size = (2 * half / spacing.array()).ceil().cast<int>() + 1;
+  v.geometry.origin = centre - Eigen::Vector3d::Constant(half);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  const double s = 0.8;
+  for (int k = 0; k < v.geometry.size[2]; ++k)
+    for (int j = 0; j < v.geometry.size[1]; ++j)
+      for (int i = 0; i < v.geometry.size[0]; ++i) {
+        const Eigen::Vector3d d = v.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - centre;
+        const double r = d.norm();
+        const double head = 660 * Phi((22 - r) / s) - 550 * Phi((21 - r) / s);
+        const double socket = d.z() > -0.2 * r ? 560 * (Phi((r - 24) / s) - Phi((r - 28) / s)) : 0.0;
+        v.at(i, j, k) = static_cast<float>(40 + head + socket);
+      }
+  return v;
+}
+
+TEST(HeadQc, ASocketsOuterSurfaceFailsOnTheSocketItFaces) {
+  // The head's cap faces its acetabulum across the gap; the acetabulum's
+  // outer surface, taken for a head where a faint head merged with it, has
+  // soft tissue beyond.
+  const Eigen::Vector3d voxels(1.5, 1.5, 3.0);
+  pipeline::HeadQcInput head = cap(22, 80);
+  const imaging::Volume ct = hipWithSocket(head.sphere_center, voxels);
+  head.socket_facing_share = pipeline::socketFacingShare(ct, head.points, head.normals);
+  ASSERT_TRUE(head.socket_facing_share);
+  EXPECT_GT(*head.socket_facing_share, 0.8);
+  EXPECT_EQ(pipeline::checkHead(head).status, "pass");
+
+  pipeline::HeadQcInput outer = cap(28, 80);
+  outer.sphere_center = head.sphere_center;
+  outer.socket_facing_share = pipeline::socketFacingShare(ct, outer.points, outer.normals);
+  ASSERT_TRUE(outer.socket_facing_share);
+  EXPECT_LT(*outer.socket_facing_share, 0.05);
+  const pipeline::QcReport r = pipeline::checkHead(outer);
+  EXPECT_EQ(check(r, "socket_facing_share").status, "fail");
+  EXPECT_EQ(r.status, "fail");
+
+  // Voxels of 3 mm within the slices resolve no gap: not measured.
+  EXPECT_FALSE(pipeline::socketFacingShare(hipWithSocket(head.sphere_center, Eigen::Vector3d::Constant(3.0)),
+                                           head.points, head.normals));
 }
 
 TEST(HeadQc, TooFewPointsAreRefused) {

@@ -34,6 +34,13 @@ constexpr double kMinInPlaneContrastHu = 100;
 // (the cut at the neck makes it less than 1); a shell is thinner (0.08-0.28
 // on phantoms and real CTs, correct or not).
 constexpr double kShellDepthRelative = 0.4;
+// The share of a hip head's points (within a slice) that face a socket:
+// 0.25-0.75 on correct phantom heads (congruent or not, gaps 1.5-5 mm, up to
+// 1.5 x 1.5 x 3 mm voxels); 0.00-0.15 where a faint head merged with its
+// socket at 1.5-2 mm voxels and the socket's outer surface was taken.
+constexpr double kSocketFacingWarn = 0.15, kSocketFacingFail = 0.08;
+constexpr double kSocketRiseHu = 100;
+constexpr double kSocketFromMm = 0.5, kSocketToMm = 8.0, kSocketStepMm = 0.25;
 constexpr int kDoubtsThatFail = 2;                              // warnings of the structure's checks
 
 std::string number(double v) {
@@ -129,6 +136,36 @@ std::optional<double> cortexContrastAcrossSlices(const imaging::Volume& ct, cons
   return median(across) / in_plane;
 }
 
+std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
+                                        const Eigen::MatrixX3d& normals) {
+  if (points.rows() == 0 || normals.rows() != points.rows()) return std::nullopt;
+  const Eigen::Vector3d& spacing = ct.geometry.spacing;
+  const int slice_axis = spacing[2] >= spacing[0] && spacing[2] >= spacing[1] ? 2 : spacing[1] >= spacing[0] ? 1 : 0;
+  double in_plane_voxel = 0;
+  for (int a = 0; a < 3; ++a)
+    if (a != slice_axis) in_plane_voxel = std::max(in_plane_voxel, spacing[a]);
+  if (in_plane_voxel > imaging::kSeparateEdgesMaxVoxelMm + 1e-6) return std::nullopt;
+  const Eigen::Vector3d slice_direction = ct.geometry.direction.col(slice_axis).normalized();
+  int lines = 0, facing = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Eigen::Vector3d n = normals.row(i).transpose().normalized(), p = points.row(i).transpose();
+    if (std::abs(n.dot(slice_direction)) > 0.5) continue;
+    double lowest = std::numeric_limits<double>::infinity(), rise = 0;
+    bool inside_grid = true;
+    for (double s = kSocketFromMm; s <= kSocketToMm + 1e-9 && inside_grid; s += kSocketStepMm) {
+      const double v = imaging::interpolate(ct, p + s * n);
+      inside_grid = std::isfinite(v);
+      lowest = std::min(lowest, v);
+      rise = std::max(rise, v - lowest);
+    }
+    if (!inside_grid) continue;
+    ++lines;
+    facing += rise >= kSocketRiseHu;
+  }
+  if (lines < kMinLinesPerGroup) return std::nullopt;
+  return static_cast<double>(facing) / lines;
+}
+
 QcReport checkHead(const HeadQcInput& in) {
   const Eigen::Index n = in.points.rows();
   if (n < 4) throw InputError("head checks need at least 4 points, found " + std::to_string(n));
@@ -175,6 +212,11 @@ QcReport checkHead(const HeadQcInput& in) {
       report.checks.push_back(grade("search_radius_difference_relative", std::abs(in.search_radius_mm - r) / r, kRadiusWarn,
                                     kRadiusFail, false, "the head search's radius differs from the fitted one, relative:"));
   }
+  if (in.socket_facing_share)
+    report.checks.push_back(grade("socket_facing_share", *in.socket_facing_share, kSocketFacingWarn, kSocketFacingFail,
+                                  true, "share of the points (within a slice) with a socket across the joint gap (a "
+                                        "hip's head faces its acetabulum; a socket's outer surface has soft tissue "
+                                        "beyond):"));
   const bool fine_voxels = in.ct_voxel_mm <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6;
   if (in.ct_edges && !fine_voxels && in.label_depth_mm && *in.label_depth_mm < kShellDepthRelative * r) {
     // A shell's outer surface is the bone's only where the CT's edge is
@@ -193,15 +235,15 @@ QcReport checkHead(const HeadQcInput& in) {
                                   "head, where a faint cortex fell below the bone window):"));
   }
   if (in.cortex_contrast_across_slices) {
-    QcCheck c = grade("cortex_contrast_across_slices", *in.cortex_contrast_across_slices, kSliceContrastWarn,
+    QcCheck contrast = grade("cortex_contrast_across_slices", *in.cortex_contrast_across_slices, kSliceContrastWarn,
                       -std::numeric_limits<double>::infinity(), true,
                       "the cortex is blurred away across the slices (its contrast over the cancellous bone there, "
                       "relative to within a slice):");
-    c.rule = "warn below " + number(kSliceContrastWarn);
-    if (c.status == "warn")
-      c.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the blur "
+    contrast.rule = "warn below " + number(kSliceContrastWarn);
+    if (contrast.status == "warn")
+      contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the blur "
                   "across the slices";
-    report.checks.push_back(c);
+    report.checks.push_back(contrast);
   }
   if (in.side_verified) {
     QcCheck side;

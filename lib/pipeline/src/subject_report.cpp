@@ -87,8 +87,8 @@ json readStageJson(const fs::path& path) {
 
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
-QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
-                          const imaging::Volume* ct) {
+QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
+                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct) {
   HeadQcInput in;
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
@@ -97,6 +97,8 @@ QcReport checkSubjectHead(const fs::path& folder, const std::vector<geometry::Sh
     in.ct_edges = pointsOnCtEdge(*ct, in.points, in.normals);
     in.ct_voxel_mm = ct->geometry.spacing.maxCoeff();
     in.cortex_contrast_across_slices = cortexContrastAcrossSlices(*ct, in.points, in.normals);
+    // A humeral head's glenoid is small and shallow: most of its cap faces none.
+    if (joint == "hip") in.socket_facing_share = socketFacingShare(*ct, in.points, in.normals);
   }
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });
@@ -258,7 +260,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
 
   std::string no_ct;
   const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
-  const QcReport qc = checkSubjectHead(o.folder, shapes, ct.get());
+  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get());
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};

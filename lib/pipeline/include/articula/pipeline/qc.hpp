@@ -7,7 +7,10 @@
 // whether the search could tell the joint's side, and whether the CT shows
 // the bone's edge where the points are (a label cut inside the head, where
 // a faint cortex fell below the bone window, has points inside the bone).
-// At coarser voxels, where the CT's edges are checked no more, a label
+// A femoral head sits in its acetabulum: beyond a good share of its
+// articular surface, across the joint gap, the CT rises again (a socket's
+// outer surface taken for a head, where a faint head merged with it, has
+// soft tissue beyond). At coarser voxels, where the CT's edges are checked no more, a label
 // much thinner than its head's radius (a shell: cancellous bone below the
 // bone window) must still have its points on the CT's edge.
 // One check is of the surface's accuracy, not of the structure: whether
@@ -41,6 +44,7 @@ struct HeadQcInput {
   std::optional<PointsOnCtEdge> ct_edges;        // where the CT's bone edge is about the points, if a CT was given
   double ct_voxel_mm = 0;                        // the CT's largest spacing: its edge checks apply up to 2 mm
   std::optional<double> label_depth_mm;          // the segmentation's label: the depth of its deepest voxel
+  std::optional<double> socket_facing_share;     // socketFacingShare, for a hip where measurable
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
 };
@@ -76,6 +80,15 @@ PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d&
 /// voxel axis of the largest spacing (the third on a tie).
 std::optional<double> cortexContrastAcrossSlices(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
                                                  const Eigen::MatrixX3d& normals);
+
+/// The share of the points whose outward normal, within a slice (|normal .
+/// slice axis| <= 0.5, where a joint gap is resolved best), meets a rise of
+/// at least 100 HU over the lowest HU before it, from 0.5 to 8 mm outside
+/// the point: a socket across a joint gap of up to about 5 mm. Empty where
+/// the voxels within a slice exceed 2 mm (a gap is not resolved) or fewer
+/// than 20 such lines lie within the grid.
+std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
+                                        const Eigen::MatrixX3d& normals);
 
 /// Runs every check that its inputs allow; throws InputError for fewer than 4 points.
 QcReport checkHead(const HeadQcInput& input);
