@@ -50,6 +50,17 @@ std::string number(double v) {
   return s.str();
 }
 
+double median(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// The voxel axis of the largest spacing (the third on a tie): across the slices.
+int sliceAxis(const Eigen::Vector3d& spacing) {
+  return spacing[2] >= spacing[0] && spacing[2] >= spacing[1] ? 2 : spacing[1] >= spacing[0] ? 1 : 0;
+}
+
 /// Grades `value` (larger is worse unless `low_is_bad`) against a warn and a fail limit.
 QcCheck grade(const std::string& name, double value, double warn, double fail, bool low_is_bad, const std::string& what) {
   QcCheck c;
@@ -103,22 +114,10 @@ PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d&
   return shares;
 }
 
-namespace {
-
-double median(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
-}  // namespace
-
 std::optional<double> cortexContrastAcrossSlices(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
                                                  const Eigen::MatrixX3d& normals) {
   if (points.rows() == 0 || normals.rows() != points.rows()) return std::nullopt;
-  const Eigen::Vector3d& spacing = ct.geometry.spacing;
-  const int slice_axis = spacing[2] >= spacing[0] && spacing[2] >= spacing[1] ? 2 : spacing[1] >= spacing[0] ? 1 : 0;
-  const Eigen::Vector3d slice_direction = ct.geometry.direction.col(slice_axis).normalized();
+  const Eigen::Vector3d slice_direction = ct.geometry.direction.col(sliceAxis(ct.geometry.spacing)).normalized();
   std::vector<double> across, within;
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d n = normals.row(i).transpose().normalized(), p = points.row(i).transpose();
@@ -140,7 +139,7 @@ std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::
                                         const Eigen::MatrixX3d& normals) {
   if (points.rows() == 0 || normals.rows() != points.rows()) return std::nullopt;
   const Eigen::Vector3d& spacing = ct.geometry.spacing;
-  const int slice_axis = spacing[2] >= spacing[0] && spacing[2] >= spacing[1] ? 2 : spacing[1] >= spacing[0] ? 1 : 0;
+  const int slice_axis = sliceAxis(spacing);
   double in_plane_voxel = 0;
   for (int a = 0; a < 3; ++a)
     if (a != slice_axis) in_plane_voxel = std::max(in_plane_voxel, spacing[a]);
@@ -236,13 +235,13 @@ QcReport checkHead(const HeadQcInput& in) {
   }
   if (in.cortex_contrast_across_slices) {
     QcCheck contrast = grade("cortex_contrast_across_slices", *in.cortex_contrast_across_slices, kSliceContrastWarn,
-                      -std::numeric_limits<double>::infinity(), true,
-                      "the cortex is blurred away across the slices (its contrast over the cancellous bone there, "
-                      "relative to within a slice):");
+                             -std::numeric_limits<double>::infinity(), true,
+                             "the cortex is blurred away across the slices (its contrast over the cancellous bone "
+                             "there, relative to within a slice):");
     contrast.rule = "warn below " + number(kSliceContrastWarn);
     if (contrast.status == "warn")
-      contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the blur "
-                  "across the slices";
+      contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the "
+                         "blur across the slices";
     report.checks.push_back(contrast);
   }
   if (in.side_verified) {

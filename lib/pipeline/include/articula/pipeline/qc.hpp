@@ -7,12 +7,12 @@
 // whether the search could tell the joint's side, and whether the CT shows
 // the bone's edge where the points are (a label cut inside the head, where
 // a faint cortex fell below the bone window, has points inside the bone).
-// A femoral head sits in its acetabulum: beyond a good share of its
-// articular surface, across the joint gap, the CT rises again (a socket's
-// outer surface taken for a head, where a faint head merged with it, has
-// soft tissue beyond). At coarser voxels, where the CT's edges are checked no more, a label
-// much thinner than its head's radius (a shell: cancellous bone below the
-// bone window) must still have its points on the CT's edge.
+// At coarser voxels, where the CT's edges are checked no more, a label much
+// thinner than its head's radius (a shell: cancellous bone below the bone
+// window) must still have its points on the CT's edge. A femoral head sits
+// in its acetabulum: beyond a good share of its articular surface, across
+// the joint gap, the CT rises again (a socket's outer surface, taken for a
+// head where a faint head merged with it, has soft tissue beyond).
 // One check is of the surface's accuracy, not of the structure: whether
 // the cortex still shows across the slices (where a thin cortex is blurred
 // away there, the edge found lies outside the bone's surface).
