@@ -4,7 +4,8 @@
 # femurs and both hips in one field of view; shoulders with small shallow
 # glenoids; point-sampled and partial-volume voxels, Gaussian, box and
 # Lorentzian blur, correlated noise, cupping, int16 with slope/intercept,
-# oblique and RAS storage, cropped fields of view with and without air.
+# oblique and RAS storage, cropped fields of view with and without air;
+# clinical voxels up to 2 x 2 x 3 mm.
 # Each head is correct (articular points' RMS to the true head <= half the
 # in-plane voxel and >= 95 % within 1.5 mm), refused (exit != 0), wrong but
 # warned (exit 0, qc "warn") or SILENTLY WRONG (exit 0, qc "pass", not
@@ -87,6 +88,27 @@ cases=(
 "Y08|right|joint=shoulder side=right seed=508 R=22 gap=3 excess=8 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 fov=75,75,75 spacing=0.7,0.7,1.0 noise=15"
 "Y09|left|joint=hip side=left seed=509 R=21 gap=2 cortex=0.7 cort_hu=600 trab_hu=120 tex=50 spacing=0.8,0.8,1.25 noise=20"
 "Y10|right|joint=hip side=right seed=510 R=23 gap=2.5 fov=70,70,70 fov_shift=-60,0,0 spacing=0.7,0.7,1.0"
+# Clinical coarse voxels (1-2 mm within the slices, 2-3 mm slices): faint and
+# thin cortices, narrow gaps, small and large heads, both hips.
+"C1|left|joint=hip side=left seed=601 R=23 gap=2.5 cortex=0.8 cort_hu=800 trab_hu=200 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+"C2|right|joint=hip side=right seed=602 R=25 gap=3 cortex=1.5 spacing=1.5,1.5,3.0 blur_xy=1.0 blur_z=2.0"
+"C3|right|joint=shoulder side=right seed=603 R=22 gap=3 excess=8 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 noise=20 fov=80,80,80 spacing=1.5,1.5,3.0 blur_xy=0.7 blur_z=1.3"
+"C4|right left|joint=hip both=1 side=right seed=604 R=24 gap=2.5 fov=175,75,70 spacing=1.5,1.5,3.0 blur=box blur_xy=1.5 blur_z=3.0 sub=1"
+"C5|left|joint=hip side=left seed=605 R=18 gap=1.5 cover=115 excess=0.5 spacing=1.5,1.5,3.0"
+"C6|right|joint=hip side=right seed=606 R=30 gap=4 cortex=2.0 cort_hu=1400 trab_hu=350 spacing=1.5,1.5,3.0 blur=lorentz blur_xy=0.5 blur_z=1.0 fov=80,80,80"
+"C7|left|joint=hip side=left seed=607 R=21 gap=2 cortex=0.7 cort_hu=700 trab_hu=150 spacing=1.5,1.5,1.5 blur_xy=1.2 blur_z=1.2"
+"C8|right|joint=hip side=right seed=608 R=26 gap=2.5 cortex=1.0 spacing=2.0,2.0,2.0 blur_xy=1.0 blur_z=1.0 fov=75,75,75"
+"C9|left|joint=shoulder side=left seed=609 R=24 gap=3 excess=8 cortex=0.8 cort_hu=900 spacing=1.2,1.2,2.5 blur_xy=0.6 blur_z=1.8 fov=80,80,80"
+"C10|left|joint=hip side=left seed=610 R=20 gap=2 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 noise=20 spacing=1.5,1.5,3.0 blur_xy=0.7 blur_z=1.3"
+"C11|right|joint=hip side=right seed=611 R=24 gap=2.5 cortex=0.7 cort_hu=600 trab_hu=150 tex=40 noise=25 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+"C12|right|joint=shoulder side=right seed=612 R=24 gap=3 excess=8 cortex=1.0 cort_hu=800 trab_hu=200 fov=80,80,80 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+"C13|left right|joint=hip both=1 side=left seed=613 R=22 gap=2 cortex=0.8 cort_hu=700 trab_hu=150 tex=50 fov=175,75,70 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+"C14|left|joint=hip side=left seed=614 R=28 gap=1.5 cover=120 excess=0.5 cortex=1.0 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+"C15|right|joint=hip side=right seed=615 R=17 gap=2 cortex=0.8 cort_hu=700 trab_hu=150 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+"C16|left|joint=shoulder side=left seed=616 R=22 gap=3 excess=8 cortex=0.6 cort_hu=600 trab_hu=120 tex=60 noise=20 fov=80,80,80 spacing=1.2,1.2,2.5 blur_xy=0.6 blur_z=1.2"
+"C17|right|joint=hip side=right seed=617 R=23 gap=2.5 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 noise=20 spacing=1.0,1.0,2.0 blur_xy=0.5 blur_z=1.0"
+"C18|left|joint=hip side=left seed=618 R=24 gap=2.5 cortex=0.8 cort_hu=700 trab_hu=150 spacing=2.0,2.0,3.0 blur_xy=1.0 blur_z=1.5 fov=80,80,80"
+"C19|right|joint=shoulder side=right seed=619 R=25 gap=3 excess=8 cortex=0.7 cort_hu=600 trab_hu=100 tex=40 noise=15 fov=80,80,80 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
 )
 echo "| case | side | joint | voxels (mm) | cortex (mm) | gap (mm) | exit | qc | verdict | centre error (mm) | mean signed (mm) | RMS (mm) | within 1.5 mm | message |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
