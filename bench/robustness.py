@@ -86,8 +86,11 @@ def run_ct(ct, bin_dir, work, run_args=()):
             row["qc"] = results.get("qc", {}).get("status", "")
             limit = 0.5 * min(ct["spacing"][0], ct["spacing"][1])
             ok = row["rms_mm"] <= limit and row["share_within_1p5_mm"] >= 0.95
-            # Wrong with a warning in results.json and on stderr is flagged, not silent.
-            row["verdict"] = "correct" if ok else "wrong, warned" if row["qc"] == "warn" else "SILENTLY WRONG"
+            # Wrong with a warning of the head or its surface (not only of the
+            # side) in results.json and on stderr is flagged, not silent.
+            warned = any(c["status"] == "warn" and c["name"] != "side_verified"
+                         for c in results.get("qc", {}).get("checks", []))
+            row["verdict"] = "correct" if ok else "wrong, warned" if warned else "SILENTLY WRONG"
         else:
             row["verdict"] = "refused"
         rows.append(row)
