@@ -22,9 +22,9 @@ constexpr double kCentreWarn = 0.15, kCentreFail = 0.30;      // search vs fit, 
 constexpr double kRadiusWarn = 0.15, kRadiusFail = 0.30;      // relative difference
 constexpr double kEdgeFail = 0.4, kEdgeWarn = 0.6;            // share of the points on the CT's edge (a 1.5 mm gap and a thin cortex: down to 0.69 on correct heads)
 constexpr double kInsideWarn = 0.15, kInsideFail = 0.30;      // share of the points inside the bone (a 1.5 mm gap at 1 mm voxels: up to 0.12 on correct heads)
-// The cortex's contrast across the slices relative to within them: 0.48-1.0
+// The cortex's contrast across the slices relative to within them: 0.38-1.05
 // on the correct heads of two phantom generators (1.5 x 1.5 x 3 mm voxels
-// included); 0.08-0.26 where a thin cortex under 1.5-2.5 mm of blur across
+// included); 0.06-0.26 where a thin cortex under 1.5-2.5 mm of blur across
 // 2-3 mm slices put the surface 0.36-0.79 mm outside on average.
 constexpr double kSliceContrastWarn = 0.3;
 constexpr double kSliceAxisShare = 0.8, kInPlaneShare = 0.3;  // |normal . slice axis| of the two groups of lines
@@ -35,7 +35,7 @@ constexpr double kMinInPlaneContrastHu = 100;
 // on phantoms and real CTs, correct or not).
 constexpr double kShellDepthRelative = 0.4;
 // The share of a hip head's points (within a slice) that face a socket:
-// 0.25-0.75 on correct phantom heads (congruent or not, gaps 1.5-5 mm, up to
+// 0.25-0.97 on correct phantom heads (congruent or not, gaps 1.5-5 mm, up to
 // 1.5 x 1.5 x 3 mm voxels); 0.00-0.15 where a faint head merged with its
 // socket at 1.5-2 mm voxels and the socket's outer surface was taken.
 constexpr double kSocketFacingWarn = 0.15, kSocketFacingFail = 0.08;
