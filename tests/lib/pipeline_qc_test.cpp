@@ -5,6 +5,7 @@
 // off the CT's edges at coarse voxels, a socket's outer surface that faces
 // no socket); a cortex blurred away across the slices warns.
 #include <cmath>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -31,6 +32,9 @@ pipeline::HeadQcInput cap(double radius, double cap_deg, bool inward_normals = f
   in.sphere_radius_mm = radius;
   return in;
 }
+
+/// The standard normal distribution function.
+double Phi(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 
 const pipeline::QcCheck& check(const pipeline::QcReport& r, const std::string& name) {
   for (const auto& c : r.checks)
@@ -129,7 +133,6 @@ imaging::Volume faintHead(const Eigen::Vector3d& centre) {
   v.geometry.spacing = Eigen::Vector3d::Constant(h);
   v.geometry.origin = centre - Eigen::Vector3d::Constant(39.5 * h);
   v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
-  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
   const double s = 0.6;
   for (int k = 0; k < 80; ++k)
     for (int j = 0; j < 80; ++j)
@@ -164,6 +167,22 @@ TEST(HeadQc, PointsInsideTheBoneFailOnTheCtsEdges) {
   EXPECT_EQ(r.status, "fail");
 }
 
+/// A cube of side 2 `half_mm` about `centre` on voxels of `spacing`, each
+/// voxel's HU `hu` of its offset from the centre (point-sampled).
+imaging::Volume volumeAbout(const Eigen::Vector3d& centre, double half_mm, const Eigen::Vector3d& spacing,
+                            const std::function<double(const Eigen::Vector3d&)>& hu) {
+  imaging::Volume v;
+  v.geometry.spacing = spacing;
+  v.geometry.size = (2 * half_mm / spacing.array()).ceil().cast<int>() + 1;
+  v.geometry.origin = centre - Eigen::Vector3d::Constant(half_mm);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  for (int k = 0; k < v.geometry.size[2]; ++k)
+    for (int j = 0; j < v.geometry.size[1]; ++j)
+      for (int i = 0; i < v.geometry.size[0]; ++i)
+        v.at(i, j, k) = static_cast<float>(hu(v.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - centre));
+  return v;
+}
+
 /// A head of radius 22 mm about `centre` with a cortex `cortex_mm` thick
 /// (900 HU over 250 HU cancellous bone, 40 HU around), point-sampled on
 /// voxels of `spacing`, blurred along its normal by the Gaussian that an
@@ -171,22 +190,11 @@ TEST(HeadQc, PointsInsideTheBoneFailOnTheCtsEdges) {
 /// has there: exact for a surface flat over a few sigma.
 imaging::Volume shellHead(const Eigen::Vector3d& centre, double cortex_mm, double sigma_xy, double sigma_z,
                           const Eigen::Vector3d& spacing) {
-  imaging::Volume v;
-  const double half = 28;
-  v.geometry.spacing = spacing;
-  v.geometry.size = (2 * half / spacing.array()).ceil().cast<int>() + 1;
-  v.geometry.origin = centre - Eigen::Vector3d::Constant(half);
-  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
-  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
-  for (int k = 0; k < v.geometry.size[2]; ++k)
-    for (int j = 0; j < v.geometry.size[1]; ++j)
-      for (int i = 0; i < v.geometry.size[0]; ++i) {
-        const Eigen::Vector3d d = v.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - centre;
-        const double r = d.norm(), nz2 = r > 0 ? d.z() * d.z() / (r * r) : 0;
-        const double s = std::sqrt(sigma_xy * sigma_xy * (1 - nz2) + sigma_z * sigma_z * nz2);
-        v.at(i, j, k) = static_cast<float>(40 + 860 * Phi((22 - r) / s) - 650 * Phi((22 - cortex_mm - r) / s));
-      }
-  return v;
+  return volumeAbout(centre, 28, spacing, [&](const Eigen::Vector3d& d) {
+    const double r = d.norm(), nz2 = r > 0 ? d.z() * d.z() / (r * r) : 0;
+    const double s = std::sqrt(sigma_xy * sigma_xy * (1 - nz2) + sigma_z * sigma_z * nz2);
+    return 40 + 860 * Phi((22 - r) / s) - 650 * Phi((22 - cortex_mm - r) / s);
+  });
 }
 
 TEST(HeadQc, ACortexBlurredAwayAcrossTheSlicesWarns) {
@@ -257,24 +265,13 @@ TEST(HeadQc, AShellLabelOffTheCtsEdgesFailsAtCoarseVoxels) {
 /// the head's upper half, in 40 HU soft tissue; blurred radially (0.8 mm),
 /// on voxels of `spacing`.
 imaging::Volume hipWithSocket(const Eigen::Vector3d& centre, const Eigen::Vector3d& spacing) {
-  imaging::Volume v;
-  const double half = 34;
-  v.geometry.spacing = spacing;
-  v.geometry.size = (2 * half / spacing.array()).ceil().cast<int>() + 1;
-  v.geometry.origin = centre - Eigen::Vector3d::Constant(half);
-  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
-  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
-  const double s = 0.8;
-  for (int k = 0; k < v.geometry.size[2]; ++k)
-    for (int j = 0; j < v.geometry.size[1]; ++j)
-      for (int i = 0; i < v.geometry.size[0]; ++i) {
-        const Eigen::Vector3d d = v.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - centre;
-        const double r = d.norm();
-        const double head = 660 * Phi((22 - r) / s) - 550 * Phi((21 - r) / s);
-        const double socket = d.z() > -0.2 * r ? 560 * (Phi((r - 24) / s) - Phi((r - 28) / s)) : 0.0;
-        v.at(i, j, k) = static_cast<float>(40 + head + socket);
-      }
-  return v;
+  constexpr double s = 0.8;
+  return volumeAbout(centre, 34, spacing, [](const Eigen::Vector3d& d) {
+    const double r = d.norm();
+    const double head = 660 * Phi((22 - r) / s) - 550 * Phi((21 - r) / s);
+    const double socket = d.z() > -0.2 * r ? 560 * (Phi((r - 24) / s) - Phi((r - 28) / s)) : 0.0;
+    return 40 + head + socket;
+  });
 }
 
 TEST(HeadQc, ASocketsOuterSurfaceFailsOnTheSocketItFaces) {
