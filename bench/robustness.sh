@@ -8,8 +8,8 @@
 # RMS to the true surface <= half the in-plane voxel and >= 95 % of them
 # within 1.5 mm), refused (exit != 0), wrong but warned (exit 0, a check of
 # the head or its surface warned: not only the side's) or SILENTLY WRONG
-# (exit 0, not correct, no such warning). Prints a markdown table of the shares per spacing group and one
-# row per head, then the selected model against the true model (a confusion
+# (exit 0, not correct, no such warning). Prints a markdown table of the
+# shares per spacing group and one row per head, then the selected model against the true model (a confusion
 # matrix); writes WORK/robustness.md and WORK/robustness.json.
 #   bash bench/robustness.sh [-j N] [--quick] [--ids g0-00,g0-03] [--run-args '--edge-model cortex'] [build/bin] [WORK]
 # Needs build/bin/articula and build/bin/bench-score-head (the scorer).

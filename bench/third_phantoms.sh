@@ -10,8 +10,7 @@
 # in-plane voxel and >= 95 % within 1.5 mm), refused (exit != 0), wrong but
 # warned (exit 0, a check of the head or its surface warned: not only the
 # side's) or SILENTLY WRONG (exit 0, not correct, no such warning), with the
-# qc status beside it. Prints a
-# markdown table; phantoms are cached in WORK.
+# qc status beside it. Prints a markdown table; phantoms are cached in WORK.
 #   bash bench/third_phantoms.sh [build/bin] [WORK] [case-regex]
 set -uo pipefail
 bin=$(cd "${1:-build/bin}" && pwd)
