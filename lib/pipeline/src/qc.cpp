@@ -61,17 +61,19 @@ int sliceAxis(const Eigen::Vector3d& spacing) {
   return spacing[2] >= spacing[0] && spacing[2] >= spacing[1] ? 2 : spacing[1] >= spacing[0] ? 1 : 0;
 }
 
-/// Grades `value` (larger is worse unless `low_is_bad`) against a warn and a fail limit.
-QcCheck grade(const std::string& name, double value, double warn, double fail, bool low_is_bad, const std::string& what) {
+/// Grades `value` (larger is worse unless `low_is_bad`) against a warn and,
+/// where given, a fail limit.
+QcCheck grade(const std::string& name, double value, double warn, std::optional<double> fail, bool low_is_bad,
+              const std::string& what) {
   QcCheck c;
   c.name = name;
   c.value = value;
-  const bool fails = low_is_bad ? value < fail : value > fail;
+  const bool fails = fail && (low_is_bad ? value < *fail : value > *fail);
   const bool warns = low_is_bad ? value < warn : value > warn;
   c.status = fails ? "fail" : warns ? "warn" : "pass";
-  c.rule = std::string(low_is_bad ? "warn below " : "warn above ") + number(warn) + ", fail " +
-           (low_is_bad ? "below " : "above ") + number(fail);
-  if (fails || warns) c.reason = what + " " + number(value) + " (" + (fails ? "limit " + number(fail) : "doubtful beyond " + number(warn)) + ")";
+  const std::string direction = low_is_bad ? "below " : "above ";
+  c.rule = "warn " + direction + number(warn) + (fail ? ", fail " + direction + number(*fail) : "");
+  if (fails || warns) c.reason = what + " " + number(value) + " (" + (fails ? "limit " + number(*fail) : "doubtful beyond " + number(warn)) + ")";
   return c;
 }
 
@@ -234,11 +236,12 @@ QcReport checkHead(const HeadQcInput& in) {
                                   "head, where a faint cortex fell below the bone window):"));
   }
   if (in.cortex_contrast_across_slices) {
+    // Of the surface's accuracy, not of the structure: it only warns.
     QcCheck contrast = grade("cortex_contrast_across_slices", *in.cortex_contrast_across_slices, kSliceContrastWarn,
-                             -std::numeric_limits<double>::infinity(), true,
+                             std::nullopt, true,
                              "the cortex is blurred away across the slices (its contrast over the cancellous bone "
                              "there, relative to within a slice):");
-    contrast.rule = "warn below " + number(kSliceContrastWarn);
+    contrast.of_structure = false;
     if (contrast.status == "warn")
       contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the "
                          "blur across the slices";
@@ -247,6 +250,7 @@ QcReport checkHead(const HeadQcInput& in) {
   if (in.side_verified) {
     QcCheck side;
     side.name = "side_verified";
+    side.of_structure = false;
     side.value = *in.side_verified ? 1 : 0;
     side.rule = "warn when neither the body's middle, a field of view holding both sides, nor the socket tells the side";
     side.status = *in.side_verified ? "pass" : "warn";
@@ -260,9 +264,7 @@ QcReport checkHead(const HeadQcInput& in) {
   // head with two warnings had taken part of its socket; no correct head
   // had more than one).
   int doubts = 0;
-  // Two checks are not of the structure: the side, and the cortex across the slices.
-  for (const QcCheck& check : report.checks)
-    doubts += check.status == "warn" && check.name != "side_verified" && check.name != "cortex_contrast_across_slices";
+  for (const QcCheck& check : report.checks) doubts += check.status == "warn" && check.of_structure;
   if (doubts >= kDoubtsThatFail) {
     QcCheck together;
     together.name = "doubtful_checks";

@@ -53,6 +53,7 @@ struct QcCheck {
   std::string name, status;  // status: pass, warn or fail
   double value = 0;
   std::string rule, reason;  // the limits; why it warned or failed (empty on pass)
+  bool of_structure = true;  // a doubt about the structure taken (two such warnings fail the head)
 };
 
 struct QcReport {
