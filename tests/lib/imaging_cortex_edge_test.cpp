@@ -1,8 +1,11 @@
 // The blurred-cortex model: on a flat cortex of known thickness, blurred by a
-// known Gaussian and averaged over each voxel (closed form), with CT noise,
-// the point-spread is estimated from the CT alone and the model puts the
-// surface where it is, also where the cortex is thin enough for the steepest
-// fall to lie a fifth of a millimetre outside.
+// known Gaussian and averaged over each voxel (closed form), or averaged over
+// each voxel and then blurred on the voxel grid (as an image filter does),
+// with CT noise, the point-spread and how it was applied are estimated from
+// the CT alone and the model puts the surface where it is, also where the
+// cortex is thin enough for the steepest fall to lie a fifth of a
+// millimetre outside.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <utility>
@@ -31,9 +34,19 @@ struct FlatCortex {
 
   // A socket beyond a joint gap: its cortex and cancellous bone (none when the gap is 0).
   double gap = 0, socket_thickness = 0.8, socket_cortical = 700, socket_cancellous = 190;
+  // The blur applied to the voxels along each grid axis, its Gaussian's
+  // weights sampled at whole voxels (an image filter), instead of to the
+  // object before its voxels are taken (a scanner).
+  bool blur_on_grid = false;
 
-  /// The blurred profile at signed distance d beyond the surface (closed form).
+  /// The profile at signed distance d beyond the surface, blurred by the
+  /// scanner (closed form) or not yet (blurred on the grid later).
   double blurred(double d) const {
+    if (blur_on_grid) {
+      double hu = d > 0 ? soft : d > -thickness ? cortical : cancellous;
+      if (gap > 0 && d > gap) hu = d < gap + socket_thickness ? socket_cortical : socket_cancellous;
+      return hu;
+    }
     double hu = soft + (cortical - soft) * Phi(-d / sigma) - (cortical - cancellous) * Phi(-(d + thickness) / sigma);
     if (gap > 0)
       hu += (socket_cortical - soft) * Phi((d - gap) / sigma) -
@@ -62,8 +75,34 @@ struct FlatCortex {
     for (int k = 0; k < size.z(); ++k)
       for (int j = 0; j < size.y(); ++j)
         for (int i = 0; i < size.x(); ++i)
-          v.at(i, j, k) = static_cast<float>(voxel(v.geometry.toPhysical(Eigen::Vector3d(i, j, k))) + noise_hu(rng));
+          v.at(i, j, k) = static_cast<float>(voxel(v.geometry.toPhysical(Eigen::Vector3d(i, j, k))));
+    if (blur_on_grid) blurOnGrid(v);
+    for (float& hu : v.voxels) hu += static_cast<float>(noise_hu(rng));
     return v;
+  }
+  /// The Gaussian's weights sampled at whole voxels to four widths (as
+  /// image filters take it), applied along each axis, the edges clamped.
+  void blurOnGrid(imaging::Volume& v) const {
+    const double width = sigma / spacing;
+    const int reach = static_cast<int>(std::ceil(4 * width));
+    std::vector<double> w;
+    double sum = 0;
+    for (int t = -reach; t <= reach; ++t) sum += w.emplace_back(std::exp(-0.5 * t * t / (width * width)));
+    for (double& x : w) x /= sum;
+    for (int axis = 0; axis < 3; ++axis) {
+      const imaging::Volume in = v;
+      for (int k = 0; k < size.z(); ++k)
+        for (int j = 0; j < size.y(); ++j)
+          for (int i = 0; i < size.x(); ++i) {
+            double hu = 0;
+            for (int t = -reach; t <= reach; ++t) {
+              Eigen::Vector3i at(i, j, k);
+              at[axis] = std::clamp(at[axis] + t, 0, size[axis] - 1);
+              hu += w[static_cast<size_t>(t + reach)] * in.at(at.x(), at.y(), at.z());
+            }
+            v.at(i, j, k) = static_cast<float>(hu);
+          }
+    }
   }
 };
 
@@ -92,7 +131,7 @@ double meanModelSurface(const std::vector<imaging::LineVoxels>& lines, const std
   double sum = 0;
   found = 0;
   for (size_t i = 0; i < lines.size(); ++i) {
-    const imaging::CortexFit f = imaging::fitCortex(lines[i], 0.0, spread.along(lines[i]));
+    const imaging::CortexFit f = imaging::fitCortex(lines[i], 0.0, imaging::StepResponse(lines[i], spread));
     if (!f.found) continue;
     sum += starts[i] + f.offset_mm;
     ++found;
@@ -122,10 +161,35 @@ TEST(CortexEdge, PointSpreadAndSurfaceOfAThinCortexFromTheCtAlone) {
   FlatCortex thin;
   const Estimate e = measure(thin, 7);
   ASSERT_TRUE(e.spread.found);
+  EXPECT_EQ(e.spread.kind, imaging::PointSpread::Kind::Scanner);
   EXPECT_NEAR(e.spread.sigma_mm, thin.sigma, 0.03);
   EXPECT_GT(e.found, 250);
   EXPECT_GT(e.mean_steepest - 0.0, 0.12);  // the steepest fall's outward pull ...
   EXPECT_NEAR(e.mean_model, 0.0, 0.05);    // ... which the model does not have
+}
+
+// The same cortex blurred on the voxel grid at 0.8 mm voxels: the grid's
+// three weights (0.18, 0.64, 0.18) are not the Gaussian the scanner's model
+// has, which puts this surface 0.13 mm inside at the true width. The CT's
+// profiles choose the grid's blur, and the surface is where it is.
+TEST(CortexEdge, ABlurAppliedOnTheVoxelGrid) {
+  FlatCortex filtered;
+  filtered.blur_on_grid = true;
+  filtered.spacing = 0.8;
+  filtered.size = Eigen::Vector3i(22, 36, 36);
+  std::vector<double> starts;
+  const std::vector<imaging::LineVoxels> lines = linesAcross(filtered, 12, starts);
+  const imaging::PointSpread spread = imaging::estimatePointSpread(lines);
+  ASSERT_TRUE(spread.found);
+  EXPECT_EQ(spread.kind, imaging::PointSpread::Kind::VoxelGrid);
+  EXPECT_NEAR(spread.sigma_mm, filtered.sigma, 0.03);
+  int found = 0;
+  EXPECT_NEAR(meanModelSurface(lines, starts, spread, found), 0.0, 0.05);
+  EXPECT_GT(found, 250);
+  // Had the blur been taken for the scanner's at the true width:
+  imaging::PointSpread scanner;
+  scanner.sigma_mm = scanner.slice_sigma_mm = filtered.sigma;
+  EXPECT_LT(meanModelSurface(lines, starts, scanner, found), -0.08);
 }
 
 TEST(CortexEdge, ThickCortexAndCoarseVoxels) {

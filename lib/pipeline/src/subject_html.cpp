@@ -156,7 +156,8 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
       p << ", then the outer surface of a blurred-cortex model fitted to the voxels about it, with the scanner's "
         << "Gaussian point-spread " << (member(edges, "point_spread_estimated") == true ? "estimated from the CT" : "given")
         << ": " << fixed(numberAt(edges, "point_spread_mm"), 2) << " mm within the slices and "
-        << fixed(numberAt(edges, "slice_point_spread_mm"), 2) << " mm across them";
+        << fixed(numberAt(edges, "slice_point_spread_mm"), 2) << " mm across them"
+        << (text(edges, "point_spread_applied") == "voxel_grid" ? ", applied to the voxels as an image filter does" : "");
     p << ")";
   }
   p << ". The articular surface was selected and down-sampled to ";

@@ -15,6 +15,15 @@
 // Gaussian, wider across the slices than within them) is estimated once
 // over many profiles of the same CT (estimatePointSpread) and then held
 // fixed for every line, at its width along that line.
+//
+// How the blur met the voxels matters as much as its width when the cortex
+// is about a voxel thin: a scanner blurs the object before its voxels are
+// taken (a Gaussian of the line's width, with each voxel's extent), but an
+// image filter (a smoothed or resampled CT, a synthetic one) blurs the
+// voxels themselves, with weights sampled at whole voxels along each grid
+// axis. At 0.8 mm voxels under 0.5 mm of blur the two place an 0.8 mm
+// cortex's surface 0.13 mm apart, so both are tried and the CT's own
+// profiles choose (PointSpread::Kind).
 #include <cmath>
 #include <vector>
 
@@ -33,6 +42,8 @@ struct LineVoxels {
   std::vector<double> offset_mm, value_hu;
   double box_variance_mm2 = 0;  // the voxel's extent along u, as a variance (partial volume)
   double slice_share = 0;       // (u . slice axis)^2: how far the line runs across the slices
+  Eigen::Vector3d spacing_mm = Eigen::Vector3d::Zero();    // the grid's, per axis
+  Eigen::Vector3d axis_step_mm = Eigen::Vector3d::Zero();  // how far along u one voxel's step along each grid axis goes
 };
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
                            double to_mm, double radius_mm, double curvature_per_mm = 0);
@@ -45,28 +56,59 @@ constexpr double kCortexInwardMm = 3.5, kCortexOutwardMm = 2.5;
 /// least 0.8 mm): enough for the model's seven unknowns at any voxel size.
 double lineRadiusFor(const ImageGeometry& geometry);
 
+struct PointSpread;
+
+/// The share of a blurred step's bright side that a voxel sees, as a
+/// function of the voxel centre's depth behind the step (mm; negative in
+/// front of it): Phi(depth / width) for a Gaussian of the line's width with
+/// the voxel's extent; for a blur on the voxel grid, the grid's weights laid
+/// along the line, spread by the voxel's extent and summed into a table.
+class StepResponse {
+ public:
+  /// A Gaussian of this width along the line (the voxel's extent included).
+  explicit StepResponse(double width_mm) : width_mm_(width_mm) {}
+  /// `spread`'s blur along `line`, the voxel's extent added.
+  StepResponse(const LineVoxels& line, const PointSpread& spread);
+  double brightShare(double depth_mm) const;
+  bool valid() const { return width_mm_ > 0 || !table_.empty(); }
+
+ private:
+  double width_mm_ = 0;
+  double table_first_mm_ = 0;  // depth of table_[0]
+  std::vector<double> table_;  // the share every kTableStepMm
+};
+
 struct CortexFit {
   bool found = false;
   double offset_mm = 0;        // the outer (periosteal) surface along u
   double thickness_mm = 0;     // the cortex
   double outside_hu = 0, cortex_hu = 0, inside_hu = 0;
+  double gap_mm = 0, socket_hu = 0;  // the step beyond the surface (socket_hu == outside_hu: none)
   double sum_squares = 0;      // of the residuals, HU^2
 };
 
-/// The blurred-cortex model fitted to `line` with the scanner's Gaussian
-/// point-spread `sigma_mm` (the voxel's extent is added), the surface
-/// searched within 1 mm of `guess_mm`. Where the voxels rise again beyond
+/// The blurred-cortex model fitted to `line` with the steps blurred as
+/// `response` says, the surface searched within 1 mm of `guess_mm`. Where the voxels rise again beyond
 /// the edge (a socket across a joint gap), the window ends within that rise.
 /// Not found when the fit puts no bright layer on the bone side (cortex or
 /// bone at least `min_contrast_hu` above the outside) or the surface at the
 /// search's end.
+CortexFit fitCortex(const LineVoxels& line, double guess_mm, const StepResponse& response,
+                    double min_contrast_hu = 150);
+/// The same with the scanner's Gaussian point-spread `sigma_mm` along the
+/// line (the voxel's extent is added).
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
 
 /// The scanner's Gaussian point-spread (standard deviations): one width
 /// within the slices and one across them (a CT's slice profile is often
 /// wider than its in-plane blur).
 struct PointSpread {
+  /// Where the blur was applied: before the voxels were taken (a scanner),
+  /// or to the voxels along each grid axis, its Gaussian's weights sampled
+  /// at whole voxels (an image filter: a smoothed, resampled or synthetic CT).
+  enum class Kind { Scanner, VoxelGrid };
   bool found = false;
+  Kind kind = Kind::Scanner;
   double sigma_mm = 0;        // within the slices
   double slice_sigma_mm = 0;  // across them (along the slice axis, the grid's third index)
   int profiles = 0;           // lines it was estimated on
@@ -78,16 +120,21 @@ struct PointSpread {
 
 /// The point-spread that lets the blurred-cortex model fit `lines` (each
 /// centred on its edge's first guess) best, by the profile likelihood of
-/// the widths: each line's residual after its own fit, on a log scale (a
-/// line the model cannot explain, a socket's rim or a cut through the bone,
-/// weighs no more than one it fits; summed residuals let such lines pull
-/// the width). First one width for both directions (a grid over 0.05-2 mm,
-/// then a golden-section search), then each width in turn with the other
-/// held, within a factor 2.5 of the first. Lines that face a socket are
-/// left out while 30 others remain. Not found with fewer than 30
-/// lines or when the one width's least lies at the end of its range. Lines
-/// that hardly cross the slices (their shares summing to less than a tenth
-/// of the lines) give one width for both.
+/// its kind and widths: each line's residual after its own fit, on a log
+/// scale (a line the model cannot explain, a socket's rim or a cut through
+/// the bone, weighs no more than one it fits; summed residuals let such
+/// lines pull the width). First, for each kind, one width for both
+/// directions (a grid over 0.05-2 mm, then parabolas through the
+/// likelihood about its best, which jumps by a few units from width to
+/// width as each line's search ends a little differently); the kind that
+/// fits better is kept. Then the slice width and the width within the
+/// slices, each within a factor 2.5 of the common one, replace it only when
+/// they fit better by more than the log of the voxels' count (the Bayesian
+/// information criterion). Lines that face a socket are left out while 30
+/// others remain. Not found with fewer than 30 lines or when the one
+/// width's least lies at the end of its range. Lines that hardly cross the
+/// slices (their shares summing to less than a tenth of the lines) give one
+/// width for both.
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
 
 }  // namespace articula::imaging

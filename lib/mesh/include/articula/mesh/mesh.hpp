@@ -84,6 +84,7 @@ struct EdgeSnapSummary {
   bool cortex_model = false;
   double point_spread_mm = 0, slice_point_spread_mm = 0;  // within the slices, across them
   bool point_spread_estimated = false;
+  bool point_spread_on_voxel_grid = false;  // the blur was an image filter's on the voxels (imaging::PointSpread::Kind)
   long long on_cortex_model = 0;
   double mean_model_shift_mm = 0;
   std::string cortex_model_note;  // why the model was not used, when it was asked for
