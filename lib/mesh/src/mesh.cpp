@@ -338,7 +338,8 @@ Eigen::MatrixX3d smoothedNormals(const TriangleMesh& mesh, const std::vector<std
 /// outer surface of the blurred-cortex model, with one point-spread for the
 /// whole CT (given, or estimated on up to 600 of the found edges spread over
 /// the surface: with 300, about 170 of them facing no socket, the kind of
-/// blur was taken wrongly at 0.6 mm voxels). A vertex whose model does not fit keeps its steepest fall.
+/// blur was taken wrongly at 0.6 mm voxels). A vertex whose model does not
+/// fit keeps its steepest fall.
 void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
                         const imaging::Volume& ct, const std::vector<char>& found, std::vector<double>& shift,
                         const EdgeSnapOptions& options, EdgeSnapSummary& s) {
@@ -353,8 +354,10 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   std::vector<char> reached = found;
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), averaged, reached);
   TriangleMesh on_falls = mesh;
-  for (Eigen::Index v = 0; v < on_falls.vertices.rows(); ++v)
-    if (reached[static_cast<size_t>(v)]) on_falls.vertices.row(v) += averaged[static_cast<size_t>(v)] * mesh.normals.row(v);
+  for (Eigen::Index v = 0; v < on_falls.vertices.rows(); ++v) {
+    const auto at = static_cast<size_t>(v);
+    if (reached[at]) on_falls.vertices.row(v) += averaged[at] * mesh.normals.row(v);
+  }
   on_falls.normals = fromVtk(withNormals(toVtk(on_falls))).normals;
   on_falls.normals = smoothedNormals(on_falls, neighbours);
   const std::vector<double> curvature = meanCurvature(on_falls, neighbours);

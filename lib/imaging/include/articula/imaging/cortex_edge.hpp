@@ -83,7 +83,6 @@ struct CortexFit {
   double offset_mm = 0;        // the outer (periosteal) surface along u
   double thickness_mm = 0;     // the cortex
   double outside_hu = 0, cortex_hu = 0, inside_hu = 0;
-  double gap_mm = 0, socket_hu = 0;  // the step beyond the surface (socket_hu == outside_hu: none)
   double sum_squares = 0;      // of the residuals, HU^2
 };
 
