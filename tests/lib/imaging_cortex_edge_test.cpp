@@ -170,7 +170,7 @@ TEST(CortexEdge, PointSpreadAndSurfaceOfAThinCortexFromTheCtAlone) {
 
 // The same cortex blurred on the voxel grid at 0.8 mm voxels: the grid's
 // three weights (0.18, 0.64, 0.18) are not the Gaussian the scanner's model
-// has, which puts this surface 0.13 mm inside at the true width. The CT's
+// has, which puts this surface 0.19 mm inside at the true width. The CT's
 // profiles choose the grid's blur, and the surface is where it is.
 TEST(CortexEdge, ABlurAppliedOnTheVoxelGrid) {
   FlatCortex filtered;

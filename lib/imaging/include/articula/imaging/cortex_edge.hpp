@@ -87,8 +87,9 @@ struct CortexFit {
 };
 
 /// The blurred-cortex model fitted to `line` with the steps blurred as
-/// `response` says, the surface searched within 1 mm of `guess_mm`. Where the voxels rise again beyond
-/// the edge (a socket across a joint gap), the window ends within that rise.
+/// `response` says, the surface searched within 1 mm of `guess_mm`. Where
+/// the voxels rise again beyond the edge (a socket across a joint gap), the
+/// window ends within that rise.
 /// Not found when the fit puts no bright layer on the bone side (cortex or
 /// bone at least `min_contrast_hu` above the outside) or the surface at the
 /// search's end.
@@ -98,9 +99,9 @@ CortexFit fitCortex(const LineVoxels& line, double guess_mm, const StepResponse&
 /// line (the voxel's extent is added).
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
 
-/// The scanner's Gaussian point-spread (standard deviations): one width
-/// within the slices and one across them (a CT's slice profile is often
-/// wider than its in-plane blur).
+/// The CT's Gaussian point-spread (standard deviations): one width within
+/// the slices and one across them (a CT's slice profile is often wider than
+/// its in-plane blur), and how it was applied.
 struct PointSpread {
   /// Where the blur was applied: before the voxels were taken (a scanner),
   /// or to the voxels along each grid axis, its Gaussian's weights sampled
