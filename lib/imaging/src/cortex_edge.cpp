@@ -441,8 +441,9 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
   const Common scanner = commonWidth(PointSpread::Kind::Scanner), grid = commonWidth(PointSpread::Kind::VoxelGrid);
   if (!scanner.found && !grid.found) return ps;
   const bool on_grid = grid.negated_log_likelihood < scanner.negated_log_likelihood;
+  const Common& chosen = on_grid ? grid : scanner;
   ps.kind = on_grid ? PointSpread::Kind::VoxelGrid : PointSpread::Kind::Scanner;
-  const double common = on_grid ? grid.width_mm : scanner.width_mm;
+  const double common = chosen.width_mm;
   ps.sigma_mm = ps.slice_sigma_mm = common;
   // The slice width needs lines across the slices: where fewer than a tenth
   // of the lines' spread runs across them, it stays at the common one.
@@ -473,8 +474,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
   split.sigma_mm = in_plane;
   double voxels = 0;
   for (const LineVoxels& line : lines) voxels += static_cast<double>(line.offset_mm.size());
-  const double common_value = on_grid ? grid.negated_log_likelihood : scanner.negated_log_likelihood;
-  if (common_value - split_value > std::log(voxels)) ps = split;
+  if (chosen.negated_log_likelihood - split_value > std::log(voxels)) ps = split;
   ps.found = true;
   return ps;
 }

@@ -269,9 +269,8 @@ void averageShifts(const std::vector<std::vector<int>>& neighbours, int passes, 
   }
 }
 
-/// Neighbour-average passes that reach about `reach_mm` over the surface:
-/// a pass spreads by about an edge, k passes by about sqrt(k) edges.
-int passesToReach(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours, double reach_mm) {
+/// The mean length of the mesh's edges (mm).
+double meanEdgeLength(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours) {
   double length = 0;
   long edges = 0;
   for (size_t i = 0; i < neighbours.size(); ++i)
@@ -279,7 +278,13 @@ int passesToReach(const TriangleMesh& mesh, const std::vector<std::vector<int>>&
       length += (mesh.vertices.row(j) - mesh.vertices.row(static_cast<Eigen::Index>(i))).norm();
       ++edges;
     }
-  const double edge_mm = edges ? length / static_cast<double>(edges) : reach_mm;
+  return edges ? length / static_cast<double>(edges) : 0.0;
+}
+
+/// Neighbour-average passes that reach about `reach_mm` over a surface of
+/// edges `edge_mm` long: a pass spreads by about an edge, k passes by about
+/// sqrt(k) edges.
+int passesToReach(double edge_mm, double reach_mm) {
   return std::clamp(static_cast<int>(std::ceil(std::pow(reach_mm / std::max(edge_mm, 1e-3), 2))), 1, 200);
 }
 
@@ -289,7 +294,8 @@ int passesToReach(const TriangleMesh& mesh, const std::vector<std::vector<int>>&
 /// are noisy from edge to edge, and a joint's curvature changes over
 /// centimetres; each spread of a line's voxels about their true depths
 /// reads as blur), within +-1/5 mm.
-std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours) {
+std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
+                                  double edge_mm) {
   constexpr double kReachMm = 2.0;
   const size_t n = neighbours.size();
   std::vector<double> curvature(n, 0.0);
@@ -302,7 +308,7 @@ std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<st
     }
     if (!neighbours[i].empty()) curvature[i] = sum / static_cast<double>(neighbours[i].size());
   }
-  for (int pass = passesToReach(mesh, neighbours, kReachMm); pass > 0; --pass) {
+  for (int pass = passesToReach(edge_mm, kReachMm); pass > 0; --pass) {
     std::vector<double> next(n, 0.0);
     for (size_t i = 0; i < n; ++i) {
       double sum = curvature[i];
@@ -319,10 +325,11 @@ std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<st
 /// surface moved onto a CT's edges tilts its vertex normals by 6-8 degrees
 /// rms (0.7 mm voxels), and each degree of tilt spreads a line's voxels
 /// about their depths like blur.
-Eigen::MatrixX3d smoothedNormals(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours) {
+Eigen::MatrixX3d smoothedNormals(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
+                                 double edge_mm) {
   constexpr double kReachMm = 1.0;
   Eigen::MatrixX3d normals = mesh.normals;
-  for (int pass = passesToReach(mesh, neighbours, kReachMm); pass > 0; --pass) {
+  for (int pass = passesToReach(edge_mm, kReachMm); pass > 0; --pass) {
     Eigen::MatrixX3d next = normals;
     for (size_t i = 0; i < neighbours.size(); ++i) {
       Eigen::RowVector3d sum = normals.row(static_cast<Eigen::Index>(i));
@@ -359,8 +366,9 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     if (reached[at]) on_falls.vertices.row(v) += averaged[at] * mesh.normals.row(v);
   }
   on_falls.normals = fromVtk(withNormals(toVtk(on_falls))).normals;
-  on_falls.normals = smoothedNormals(on_falls, neighbours);
-  const std::vector<double> curvature = meanCurvature(on_falls, neighbours);
+  const double edge_mm = meanEdgeLength(on_falls, neighbours);
+  on_falls.normals = smoothedNormals(on_falls, neighbours, edge_mm);
+  const std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm);
   const auto lineAt = [&](Eigen::Index v) {
     const Eigen::Vector3d n = on_falls.normals.row(v).transpose();
     return imaging::voxelsAboutLine(ct, on_falls.vertices.row(v).transpose(), n, -imaging::kCortexInwardMm,
