@@ -22,7 +22,11 @@ find_package(nlohmann_json 3 QUIET CONFIG)
 articula_require(nlohmann_json_FOUND nlohmann-json3-dev)
 
 # Plain find_package(NLopt) finds the C-only build; the C++ one lives here.
-set(NLopt_DIR /usr/lib/x86_64-linux-gnu/cmake/nlopt_cxx CACHE PATH "NLopt C++ config")
+# A cache from a configure that ran before the package was installed may
+# hold the C-only folder: replace it.
+if(NOT NLopt_DIR MATCHES "nlopt_cxx/?$")
+  set(NLopt_DIR /usr/lib/x86_64-linux-gnu/cmake/nlopt_cxx CACHE PATH "NLopt C++ config" FORCE)
+endif()
 find_package(NLopt QUIET CONFIG)
 articula_require(NLopt_FOUND libnlopt-cxx-dev)
 

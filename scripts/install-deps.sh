@@ -1,25 +1,43 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package articula builds, tests and benchmarks with.
-# Non-interactive and idempotent: packages already present are skipped, so a
-# second run makes no network request.
+# Installs the Debian 12 packages articula needs. Non-interactive and
+# idempotent: packages already present are skipped, so a second run makes no
+# network request.
+#
+#   bash scripts/install-deps.sh         # building and running articula
+#   bash scripts/install-deps.sh --all   # and its tests, benchmarks, fuzzing,
+#                                        # browser checks and Snakemake
 set -euo pipefail
 
+# What `articula` itself builds and runs with.
 PACKAGES=(
   build-essential cmake git pkg-config libssl-dev
   libinsighttoolkit5-dev libvtk9-dev libcgal-dev libeigen3-dev
   libnlopt-cxx-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
+  # the multibody engine of lib/dynamics
+  libsimbody-dev
+  # the reports' 3-D view, inlined at build time
+  libjs-three
+)
+# What only the tests, benchmarks, fuzzing and cluster runs need.
+DEVELOPMENT_PACKAGES=(
   libgtest-dev libbenchmark-dev
-  # measured peers (contact benchmarks) and the multibody engine
-  libsimbody-dev libfcl-dev libccd-dev libbullet-dev
-  # the reports' inlined 3-D view; the browser and schema checks of the tests
-  libjs-three chromium python3-jsonschema
-  # the independent hip phantoms of bench/independent_phantoms.sh
+  # measured contact peers (bench/)
+  libfcl-dev libccd-dev libbullet-dev
+  # the browser and schema checks of the tests
+  chromium python3-jsonschema
+  # the independent hip phantoms of the tests and bench/
   python3-numpy python3-scipy
   # studies that outgrow one machine (pipelines/Snakefile)
   snakemake
   # fuzzing the readers (scripts/fuzz.sh): Clang and its libFuzzer runtime
   clang libclang-rt-14-dev
 )
+
+case "${1:-}" in
+  "") ;;
+  --all) PACKAGES+=("${DEVELOPMENT_PACKAGES[@]}") ;;
+  *) echo "usage: $0 [--all]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -5,6 +5,7 @@
 # scratch, no temporary file is left behind, and the study tables equal
 # those of an uninterrupted batch. The study selects each phantom's true
 # model (sphere, ellipsoid, superellipsoid) as the one its points support.
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 
 models=(sphere ellipsoid superellipsoid)

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # phantom -> segment -> mesh -> sample end to end, from NIfTI and from DICOM:
 # the fitted sphere of the articular points lands on the phantom's true head.
+# fixtures: sphere
+# labels: full-size
 set -euo pipefail
 B=$ARTICULA_BIN
 T=$ARTICULA_TMP
 rm -rf "$T" && mkdir -p "$T"
 
-"$B/articula" phantom -o "$T/p" --seed 5 --model sphere --gap 3 -q
+# The seed-5 sphere phantom (default 3 mm gap), made once for several tests.
+ln -s "${ARTICULA_FIXTURES:?}/sphere/phantom" "$T/p"
 # NIfTI and DICOM input; and the surface by the level set (active contour).
 for run in "$T/p/phantom.nii.gz" "$T/p/dicom" "$T/p/phantom.nii.gz --level-set 100"; do
   read -r input extra <<< "$run"

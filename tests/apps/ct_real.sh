@@ -6,6 +6,7 @@
 # sphere must be that of an adult joint head (18-30 mm), on the asked side,
 # and agree with the search's own sphere. The abdomen series holds no joint
 # head: exit code 1.
+# labels: full-size
 set -euo pipefail
 D=${ARTICULA_SHARED_DATA:-}
 [[ -d "$D/ct/hip-3mm-nifti" && -d "$D/ct/thorax-shoulders-dicom" ]] || { echo "no shared CT data: skipped"; exit 77; }

@@ -5,6 +5,7 @@
 # superellipsoid ended at 0.30 mm RMS and the run selected the superovoid
 # (a superellipsoid under another labelling). The run selects the
 # superellipsoid, which fits within 0.02 mm of the superovoid.
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 for seed in 7 12; do
   "$bin/articula" phantom -o "$tmp/p$seed" --seed "$seed" --no-dicom -q

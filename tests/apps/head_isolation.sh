@@ -5,6 +5,7 @@
 # small heads; clinical 1.5 x 1.5 x 3 mm voxels, where the run must find
 # the head or refuse, never report another structure. The articular points
 # lie on the true surface (mean signed distance of the true model's errors).
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 
 # check RUN TRUTH SIDE MAX_CENTRE_ERROR MAX_RMS: the run's head against the truth of SIDE.

@@ -10,6 +10,7 @@
 #   bone): the bone window cut the label 3 mm inside the dome, and the head
 #   was reported with its checks passing; it must be refused or found on
 #   its true surface.
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 py=/usr/bin/python3  # Debian's, with python3-numpy and python3-scipy
 "$py" -c "import numpy, scipy" 2> /dev/null || { echo "no numpy/scipy: skipped"; exit 77; }

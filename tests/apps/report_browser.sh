@@ -5,6 +5,8 @@
 # view draws a picture that is not blank (the page's own count of drawn
 # pixels, and a screenshot's), every link of study.html resolves, and the
 # report's numbers are results.json's.
+# fixtures: demo
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 command -v chromium > /dev/null || fail "chromium is not installed (scripts/install-deps.sh installs it)"
 
@@ -27,7 +29,6 @@ check_console() {
   fi
 }
 
-"$bin/articula" demo -o "$tmp/demo" --quiet > /dev/null
 "$bin/articula" phantom -o "$tmp/data/p1" --seed 4 --model ovoid --side left --no-dicom --quiet
 cat > "$tmp/study.csv" <<CSV
 subject,input,joint,side
@@ -40,7 +41,7 @@ rc=$?
 set -e
 [ "$rc" -eq 1 ] || fail "the batch with a missing input exited $rc, expected 1"
 
-for run in "$tmp/demo/run" "$tmp/study/subjects/p1"; do
+for run in "${ARTICULA_FIXTURES:?}/demo/demo/run" "$tmp/study/subjects/p1"; do
   page="file://$run/report.html"
   size=$(stat -c %s "$run/report.html")
   [ "$size" -le 5000000 ] || fail "$run/report.html is $size bytes (at most 5 MB)"

@@ -6,12 +6,13 @@
 # signed distances as a one-component point array shown through the scene's
 # own diverging colour table over a symmetric range; and every markups file
 # valid under Slicer's markups schema (v1.0.3), one markup per scene node.
+# fixtures: demo
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 src=${ARTICULA_SOURCE:?}
 /usr/bin/python3 -c "import jsonschema" 2> /dev/null || fail "python3-jsonschema is not installed (scripts/install-deps.sh)"
 
-"$bin/articula" demo -o "$tmp/demo" --quiet > /dev/null
-/usr/bin/python3 - "$tmp/demo/run" "$src/testdata/slicer/markups-schema-v1.0.3.json" <<'PY'
+/usr/bin/python3 - "${ARTICULA_FIXTURES:?}/demo/demo/run" "$src/testdata/slicer/markups-schema-v1.0.3.json" <<'PY'
 import base64, json, os, re, sys, zlib
 import xml.etree.ElementTree as ET
 import jsonschema

@@ -3,6 +3,8 @@
 # their options, inputs and outputs; every listed option is one of run's; the
 # report stage runs on its own (articula-report) as run runs it; a stage
 # option out of its range stops run before any stage.
+# fixtures: sphere
+# labels: full-size
 source "$(dirname "$0")/common.bash"
 
 expect_rc 0 "$bin/articula" stages --json
@@ -33,9 +35,10 @@ for s in stages:
         assert f"--{o}" in help_text, f"run does not take --{o}"
 PY
 
-"$bin/articula" phantom -o "$tmp/p" --seed 5 --model sphere --no-dicom --quiet
-ct="$tmp/p/phantom.nii.gz"
-expect_rc 0 "$bin/articula" run -i "$ct" -o "$tmp/r" --quiet
+# The seed-5 sphere phantom and its run, made once for several tests; the
+# run is copied, as the report stage is rerun on it below.
+ct="${ARTICULA_FIXTURES:?}/sphere/phantom/phantom.nii.gz"
+cp -r "$ARTICULA_FIXTURES/sphere/run" "$tmp/r"
 selected=$(python3 -c "import json; print(json.load(open('$tmp/r/results.json'))['selected_model'])")
 
 # The report stage alone: refuses to overwrite, then redoes run's report
