@@ -14,7 +14,5 @@ if [ "${1:-}" = "--apps" ]; then
   shift
   parts=(-DARTICULA_BUILD_TESTS=OFF -DARTICULA_BUILD_BENCH=OFF)
 fi
-launcher=()
-if command -v ccache > /dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE="${CMAKE_BUILD_TYPE:-Release}" "${parts[@]}" "${launcher[@]}" "$@"
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE="${CMAKE_BUILD_TYPE:-Release}" "${parts[@]}" "$@"
 cmake --build "$BUILD_DIR" -j"$(nproc)"

@@ -29,8 +29,11 @@ DEVELOPMENT_PACKAGES=(
   python3-numpy python3-scipy
   # studies that outgrow one machine (pipelines/Snakefile)
   snakemake
-  # fuzzing the readers (scripts/fuzz.sh): Clang and its libFuzzer runtime
+  # the sanitizer tier and fuzzing (scripts/sanitize.sh, scripts/fuzz.sh):
+  # Clang and its libFuzzer runtime
   clang libclang-rt-14-dev
+  # a compiler cache, so that CI's clean clones rebuild only what changed
+  ccache
 )
 
 case "${1:-}" in

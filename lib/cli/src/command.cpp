@@ -49,6 +49,8 @@ std::unique_ptr<Command> createCommand(const std::string& name) {
   return it->second();
 }
 
+bool hasCommand(const std::string& name) { return registry().count(name) > 0; }
+
 std::vector<std::unique_ptr<Command>> createAllCommands() {
   std::vector<std::unique_ptr<Command>> all;
   for (const auto& [name, factory] : registry()) all.push_back(factory());

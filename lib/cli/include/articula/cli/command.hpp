@@ -50,6 +50,8 @@ using CommandFactory = std::unique_ptr<Command> (*)();
 bool registerCommand(const std::string& name, CommandFactory factory);
 /// A fresh instance of the named command; throws UsageError if unknown.
 std::unique_ptr<Command> createCommand(const std::string& name);
+/// Whether a command of that name is registered.
+bool hasCommand(const std::string& name);
 /// One fresh instance of every registered command, sorted by name.
 std::vector<std::unique_ptr<Command>> createAllCommands();
 
