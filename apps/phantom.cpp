@@ -1,5 +1,10 @@
 // `articula phantom`: writes a synthetic hip CT of known femoral head shape
 // (NIfTI and a DICOM series) with its truth, the default input of the tests.
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <vector>
+
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
@@ -85,8 +90,7 @@ class PhantomCommand : public cli::Command {
     o.ras_storage = ras_;
     o.validate();
     const auto volume_path = output_ / "phantom.nii.gz";
-    if (!common.force && std::filesystem::exists(volume_path))
-      throw UsageError("refusing to overwrite " + volume_path.string() + " (use --force)");
+    const std::vector<std::filesystem::path> old_slices = checkOutputs(common.force);
 
     const phantom::Phantom p = phantom::makePhantom(o);
     log::info("phantom: " + p.truth["model"].get<std::string>() + " head at " + p.truth["head_center_mm"].dump() +
@@ -94,7 +98,7 @@ class PhantomCommand : public cli::Command {
     imaging::writeVolume(volume_path, p.ct, true);
     imaging::writeLabel(output_ / "femur_truth.nii.gz", p.femur, true);
     if (!no_dicom_) {
-      std::filesystem::remove_all(output_ / "dicom");
+      for (const auto& slice : old_slices) std::filesystem::remove(slice);
       imaging::writeDicomSeries(output_ / "dicom", p.ct, "articula phantom seed " + std::to_string(o.seed));
     }
     nlohmann::json truth = p.truth;
@@ -107,6 +111,38 @@ class PhantomCommand : public cli::Command {
   }
 
  private:
+  /// Refuses, before any work, outputs that exist (without --force) and a
+  /// dicom/ folder holding anything but the slices this command writes
+  /// (even with --force: those files are not ours to delete). Returns the
+  /// earlier slices, which a new series replaces.
+  std::vector<std::filesystem::path> checkOutputs(bool force) const {
+    namespace fs = std::filesystem;
+    if (fs::exists(output_) && !fs::is_directory(output_))
+      throw UsageError("output '" + output_.string() + "' is a file: expected a folder for phantom.nii.gz, dicom/ and truth.json");
+    std::vector<std::string> existing;
+    for (const char* name : {"phantom.nii.gz", "femur_truth.nii.gz", "truth.json"})
+      if (fs::exists(output_ / name)) existing.push_back((output_ / name).string());
+    std::vector<fs::path> slices;
+    const fs::path dicom = output_ / "dicom";
+    if (!no_dicom_ && fs::exists(dicom)) {
+      if (!fs::is_directory(dicom)) throw UsageError("'" + dicom.string() + "' is a file: expected the DICOM series' folder");
+      static const std::regex slice_name("slice_[0-9]{4,}\\.dcm");
+      for (const auto& entry : fs::directory_iterator(dicom)) {
+        if (!entry.is_regular_file() || !std::regex_match(entry.path().filename().string(), slice_name))
+          throw UsageError("'" + dicom.string() + "' holds '" + entry.path().filename().string() +
+                           "', which articula phantom did not write: move it or choose another --output");
+        slices.push_back(entry.path());
+      }
+      if (!slices.empty()) existing.push_back(dicom.string() + "/ (" + std::to_string(slices.size()) + " slices)");
+    }
+    if (!force && !existing.empty()) {
+      std::string list;
+      for (const auto& e : existing) list += (list.empty() ? "" : ", ") + e;
+      throw UsageError("refusing to overwrite " + list + " (use --force)");
+    }
+    return slices;
+  }
+
   std::filesystem::path output_;
   std::string model_, side_ = "right";
   std::vector<double> spacing_ = {0.7, 0.7, 1.5};

@@ -95,9 +95,20 @@ class RunCommand : public cli::Command {
     if (first > last) throw UsageError("--from " + from_ + " comes after --until " + until_);
     if (const std::string problem = argumentsProblem(common); !problem.empty()) throw UsageError(problem);
     if (!fs::exists(input_)) throw InputError("input '" + input_.string() + "' does not exist: expected a DICOM folder or a CT image file");
+    // Checked before it is hashed: reading a device or a pipe would never end.
+    if (!fs::is_regular_file(input_) && !fs::is_directory(input_))
+      throw InputError("input '" + input_.string() + "' is neither a file nor a folder (a device, pipe or socket): "
+                       "expected a DICOM folder or a CT image file");
+    if (fs::exists(output_) && !fs::is_directory(output_))
+      throw UsageError("output '" + output_.string() + "' is a file: expected a folder for the stages' outputs");
+    refuseOutputsNotOurs(first, last, common);
     fs::create_directories(output_ / ".articula");
     const imaging::VolumeMemory read_once;
-    if (const int stale = removeStaleTemporaries(output_))
+    // The folders a run writes in: the subject's, its errors and its stamps.
+    int stale = 0;
+    for (const fs::path& folder : {output_, output_ / "errors", output_ / ".articula"})
+      stale += removeStaleTemporaries(folder);
+    if (stale > 0)
       log::info("removed " + std::to_string(stale) + " unfinished file(s) of an interrupted earlier run");
     for (int i = first; i <= last; ++i) {
       const pipeline::StageDescription& stage = table[static_cast<size_t>(i)];
@@ -114,7 +125,11 @@ class RunCommand : public cli::Command {
         log::info("run: " + stage.name + " is up to date");
         continue;
       }
-      fs::remove(stamp_path);
+      // A stamp naming the outputs before the stage writes them: they are
+      // run's own, to replace when the stage is redone, even if it is killed.
+      json started = {{"articula", versionString()}, {"status", "started"}, {"outputs", json::object()}};
+      for (const auto& out : plan.outputs) started["outputs"][out.string()] = "";
+      writeFileAtomically(stamp_path, started.dump(2) + "\n");
       log::info("run: [" + std::to_string(i - first + 1) + "/" + std::to_string(last - first + 1) + "] " + stage.name + " ...");
       const auto t0 = std::chrono::steady_clock::now();
       const int rc = cli::runCommandInProcess(stage.name, plan.args);
@@ -168,6 +183,31 @@ class RunCommand : public cli::Command {
     if (common.verbosity == 0) p.args.push_back("--quiet");
     if (common.verbosity == 2) p.args.push_back("--verbose");
     return p;
+  }
+
+  // Refuses, before any stage runs and unless --force, a stage output that
+  // exists but that no stamp of run names: a file run did not write.
+  void refuseOutputsNotOurs(int first, int last, const cli::CommonOptions& common) const {
+    if (common.force) return;
+    std::vector<std::string> others;
+    const auto& table = pipeline::stages();
+    for (int i = first; i <= last; ++i) {
+      const pipeline::StageDescription& stage = table[static_cast<size_t>(i)];
+      const std::optional<json> stamp = readJsonFileIfValid(output_ / ".articula" / (stage.name + ".json"));
+      for (const auto& out : stage.outputs) {
+        if (!fs::exists(output_ / out)) continue;
+        bool ours = false;
+        if (stamp && stamp->contains("outputs") && stamp->at("outputs").is_object())
+          for (const auto& [written, hash] : stamp->at("outputs").items())
+            ours = ours || written == out || (written.size() > out.size() &&
+                                              written.compare(written.size() - out.size() - 1, std::string::npos, "/" + out) == 0);
+        if (!ours) others.push_back((output_ / out).string());
+      }
+    }
+    if (others.empty()) return;
+    std::string list;
+    for (const auto& o : others) list += (list.empty() ? "" : ", ") + o;
+    throw UsageError("refusing to overwrite " + list + ", which articula run did not write (use --force, or another --output)");
   }
 
   static bool upToDate(const Plan& plan, const json& stamp, const fs::path& stamp_path) {

@@ -36,7 +36,7 @@ cp "$tmp/killed/subjects/s1/results.json" "$tmp/s1-results.json"
 grep -q "3 ok (1 from an earlier run)" "$tmp/resume.err" || { cat "$tmp/resume.err" >&2; fail "s1 was redone"; }
 cmp "$tmp/s1-status.json" "$tmp/killed/subjects/s1/status.json" || fail "s1's status changed"
 cmp "$tmp/s1-results.json" "$tmp/killed/subjects/s1/results.json" || fail "s1's results changed"
-leftovers=$(find "$tmp/killed" -name '.tmp-*')
+leftovers=$(find "$tmp/killed" -name '.articula-tmp-*')
 [ -z "$leftovers" ] || fail "temporary files left behind: $leftovers"
 diff "$tmp/reference/study.csv" "$tmp/killed/study.csv" || fail "study.csv differs from an uninterrupted batch"
 diff "$tmp/reference/study_summary.csv" "$tmp/killed/study_summary.csv" || fail "study_summary.csv differs"

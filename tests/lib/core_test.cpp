@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -44,7 +45,7 @@ TEST(AtomicFile, AnUncommittedWriteLeavesNothing) {
 TEST(AtomicFile, TemporariesKeepTheExtensionAndAreHidden) {
   const fs::path t = temporaryPathFor(fs::path("a/b/label.nii.gz"));
   EXPECT_EQ(t.parent_path(), fs::path("a/b"));
-  EXPECT_EQ(t.filename().string(), ".tmp-" + std::to_string(::getpid()) + "-label.nii.gz");
+  EXPECT_EQ(t.filename().string(), ".articula-tmp-" + std::to_string(::getpid()) + "-label.nii.gz");
 }
 
 TEST(AtomicFile, OnlyTheTemporariesOfDeadWritersAreRemoved) {
@@ -56,15 +57,23 @@ TEST(AtomicFile, OnlyTheTemporariesOfDeadWritersAreRemoved) {
   ::waitpid(child, &status, 0);
   const std::string dead = std::to_string(child), alive = std::to_string(::getpid());
   fs::create_directories(dir / "errors");
-  for (const fs::path& p : {dir / (".tmp-" + dead + "-bone.vtp"), dir / "errors" / (".tmp-" + dead + "-summary.csv"),
-                            dir / (".tmp-" + alive + "-points.ply"), dir / ".tmp-notapid-x", dir / "results.json"})
+  fs::create_directories(dir / "notes");
+  const std::string ours = ".articula-tmp-";
+  // A user's files that look like temporaries, but not articula's: kept,
+  // as is everything in a subfolder not asked for; a pid beyond any
+  // integer type is no pid (it once threw from std::stoll).
+  const std::vector<fs::path> kept = {dir / (ours + alive + "-points.ply"),  // still being written
+                                      dir / (".tmp-" + dead + "-draft.txt"), dir / ".tmp-4000000-draft.txt",
+                                      dir / (ours + "99999999999999999999-x"), dir / (ours + "notapid-x"),
+                                      dir / (ours + dead), dir / "notes" / (ours + dead + "-n.txt"), dir / "results.json"};
+  for (const fs::path& p : kept) std::ofstream(p) << "x";
+  for (const fs::path& p : {dir / (ours + dead + "-bone.vtp"), dir / "errors" / (ours + dead + "-summary.csv")})
     std::ofstream(p) << "x";
-  EXPECT_EQ(removeStaleTemporaries(dir), 2);
-  EXPECT_FALSE(fs::exists(dir / (".tmp-" + dead + "-bone.vtp")));
-  EXPECT_FALSE(fs::exists(dir / "errors" / (".tmp-" + dead + "-summary.csv")));
-  EXPECT_TRUE(fs::exists(dir / (".tmp-" + alive + "-points.ply")));  // still being written
-  EXPECT_TRUE(fs::exists(dir / ".tmp-notapid-x"));
-  EXPECT_TRUE(fs::exists(dir / "results.json"));
+  EXPECT_EQ(removeStaleTemporaries(dir), 1);
+  EXPECT_EQ(removeStaleTemporaries(dir / "errors"), 1);
+  EXPECT_FALSE(fs::exists(dir / (ours + dead + "-bone.vtp")));
+  EXPECT_FALSE(fs::exists(dir / "errors" / (ours + dead + "-summary.csv")));
+  for (const fs::path& p : kept) EXPECT_TRUE(fs::exists(p)) << p;
   EXPECT_EQ(removeStaleTemporaries(dir / "nowhere"), 0);
 }
 

@@ -1,6 +1,7 @@
 #include "articula/core/atomic_file.hpp"
 
 #include <cerrno>
+#include <charconv>
 #include <csignal>
 #include <vector>
 
@@ -38,9 +39,13 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
+namespace {
+const std::string kTemporaryPrefix = ".articula-tmp-";
+}  // namespace
+
 std::filesystem::path temporaryPathFor(const std::filesystem::path& path) {
   const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  return folder / (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string());
+  return folder / (kTemporaryPrefix + std::to_string(::getpid()) + "-" + path.filename().string());
 }
 
 int removeStaleTemporaries(const std::filesystem::path& folder) {
@@ -48,13 +53,15 @@ int removeStaleTemporaries(const std::filesystem::path& folder) {
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) return 0;
   std::vector<fs::path> stale;
-  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::recursive_directory_iterator();
-       it.increment(ec)) {
+  for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name.rfind(".tmp-", 0) != 0) continue;
-    const std::string digits = name.substr(5, name.find('-', 5) - 5);
-    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
-    const pid_t pid = static_cast<pid_t>(std::stoll(digits));
+    if (name.rfind(kTemporaryPrefix, 0) != 0 || !it->is_regular_file(ec)) continue;
+    // The writer's pid: digits up to the next '-', within pid_t's range.
+    const char* first = name.data() + kTemporaryPrefix.size();
+    const char* end = name.data() + name.size();
+    pid_t pid = 0;
+    const auto [next, error] = std::from_chars(first, end, pid);
+    if (error != std::errc() || next == first || next == end || *next != '-' || pid <= 0) continue;
     if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // its writer still runs (or is not ours to ask)
     stale.push_back(it->path());
   }

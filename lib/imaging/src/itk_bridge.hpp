@@ -125,7 +125,7 @@ Image<T> readImageFile(const std::filesystem::path& path) {
 }
 
 /// ITK chooses the format from the extension, so the temporary file keeps it:
-/// folder/.tmp-<pid>-<name>, renamed into place when complete.
+/// temporaryPathFor(path), renamed into place when complete.
 template <typename T>
 void writeImageFile(const std::filesystem::path& path, const Image<T>& image, bool overwrite) {
   namespace fs = std::filesystem;

@@ -28,13 +28,15 @@ class AtomicFile {
 };
 
 /// The name a file is written under until it is complete:
-/// `<folder>/.tmp-<pid>-<name>` (hidden, and keeping the extension, from
-/// which ITK and VTK writers choose the format).
+/// `<folder>/.articula-tmp-<pid>-<name>` (hidden, named as articula's own,
+/// and keeping the extension, from which ITK and VTK writers choose the
+/// format).
 std::filesystem::path temporaryPathFor(const std::filesystem::path& path);
 
-/// Removes the temporaries (temporaryPathFor) under `folder`, recursively,
-/// whose writing process no longer runs: a killed run leaves them behind.
-/// Returns how many were removed.
+/// Removes the temporaries (temporaryPathFor) directly in `folder` (not in
+/// its subfolders) whose writing process no longer runs: a killed run leaves
+/// them behind. Any other file, whatever its name, is left alone. Returns
+/// how many were removed.
 int removeStaleTemporaries(const std::filesystem::path& folder);
 
 /// Writes `text` to `path` atomically.
