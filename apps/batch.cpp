@@ -4,10 +4,14 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <optional>
+
+#include <nlohmann/json.hpp>
 
 #include "articula/cli/command.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/pipeline/batch.hpp"
@@ -75,6 +79,7 @@ class BatchCommand : public cli::Command {
     options.quiet = common.verbosity == 0;
     options.rerun_finished = common.force;
     if (gather_only_) options.jobs = 1;
+    if (!common.force) refuseTablesNotOurs();
     fs::create_directories(study_dir_);
     pipeline::BatchSummary summary;
     if (gather_only_) {
@@ -96,6 +101,21 @@ class BatchCommand : public cli::Command {
   }
 
  private:
+  // Refuses, before any subject runs, study tables in the study folder that
+  // no earlier batch wrote (its study.json, written first, says which did).
+  void refuseTablesNotOurs() const {
+    if (fs::exists(study_dir_) && !fs::is_directory(study_dir_))
+      throw UsageError("output '" + study_dir_.string() + "' is a file: expected the study folder");
+    const std::optional<nlohmann::json> earlier = readJsonFileIfValid(study_dir_ / "study.json");
+    const bool ours = earlier && earlier->contains("provenance") && earlier->contains("subjects");
+    if (ours) return;
+    std::string others;
+    for (const char* table : {"study.csv", "study_summary.csv", "study_status.csv", "study.json", "study.svg", "study.html"})
+      if (fs::exists(study_dir_ / table)) others += (others.empty() ? "" : ", ") + (study_dir_ / table).string();
+    if (!others.empty())
+      throw UsageError("refusing to overwrite " + others + ", which articula batch did not write (use --force, or another --output)");
+  }
+
   fs::path manifest_, study_dir_, subject_config_;
   int jobs_ = 1;
   bool validate_only_ = false, gather_only_ = false;

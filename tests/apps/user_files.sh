@@ -67,6 +67,20 @@ done
 # A second run replaces what the first wrote without --force.
 touch "$p/phantom.nii.gz"
 expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$r" -q
+# batch: a study.csv of the user's in the study folder is refused by name
+# before any subject runs; a batch's own tables are replaced by its rerun.
+b="$tmp/b"
+mkdir -p "$b"
+echo "subject,mine" > "$b/study.csv"
+printf 'subject,input,joint,side\ns1,%s,hip,right\n' "$p/phantom.nii.gz" > "$tmp/manifest.csv"
+expect_rc 2 "$bin/articula" batch "$tmp/manifest.csv" -o "$b" -q
+grep -q "refusing to overwrite .*study.csv, which articula batch did not write" "$tmp/err" ||
+  fail "batch: study.csv not named: $(cat "$tmp/err")"
+[ "$(ls -A "$b")" = "study.csv" ] && [ "$(cat "$b/study.csv")" = "subject,mine" ] || fail "batch wrote before refusing"
+rm "$b/study.csv"
+expect_rc 0 "$bin/articula" batch "$tmp/manifest.csv" -o "$b" -q
+expect_rc 0 "$bin/articula" batch "$tmp/manifest.csv" -o "$b" -q
+
 # An input that is no file (a link to /dev/zero, a pipe) is refused at once,
 # not read for ever to hash it.
 ln -s /dev/zero "$tmp/zero.nii"

@@ -211,10 +211,12 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
                           {"coordinate_system", "LPS"},
                           {"units", "mm"},
                           {"provenance", provenance}};
+  // study.json first: it marks the tables as a batch's own (a batch rerun
+  // replaces them, and refuses tables no batch wrote).
+  writeFileAtomically(study_dir / "study.json", study.dump(2) + "\n");
   writeFileAtomically(study_dir / "study.csv", study_csv);
   writeFileAtomically(study_dir / "study_summary.csv", summary_csv);
   writeFileAtomically(study_dir / "study_status.csv", status_csv);
-  writeFileAtomically(study_dir / "study.json", study.dump(2) + "\n");
   if (!rows.empty()) writeFileAtomically(study_dir / "study.svg", studyFigure(rows, model_order, study_dir));
   writeFileAtomically(study_dir / "study.html", studyReportHtml(study, finished, study_dir));
   return study;
