@@ -27,6 +27,13 @@ cmp -s "$tmp/head.csv" "$tmp/head.orig" || fail "fit overwrote its input points"
 expect_rc 2 "$A" sample -i "$tmp/head.csv" -o "$tmp/head.csv" --force
 cmp -s "$tmp/head.csv" "$tmp/head.orig" || fail "sample overwrote its input"
 
+# A file whose first line drives a terminal (clear the screen, set the
+# window title): the message quotes it with the control bytes escaped.
+printf '\033[2J\033]0;owned\007hello\n' > "$tmp/esc.ply"
+expect_rc 3 "$A" fit -i "$tmp/esc.ply" -o "$tmp/esc.json"
+if LC_ALL=C grep -q $'[\x01-\x08\x0b-\x1f\x7f]' "$tmp/err"; then fail "control bytes reached the terminal: $(cat -v "$tmp/err")"; fi
+grep -qF '\x1b[2J\x1b]0;owned\x07hello' "$tmp/err" || fail "the line is not quoted escaped: $(cat -v "$tmp/err")"
+
 # A fits.json whose models are 10^5 nested arrays: a message, not a stack overflow.
 python3 -c "import sys; sys.stdout.write('{\"models\": ' + '[' * 100000 + ']' * 100000 + '}')" > "$tmp/deep.json"
 expect_rc 3 "$A" errors -i "$tmp/head.csv" --fits "$tmp/deep.json" -o "$tmp/deep"

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <mutex>
 
@@ -13,9 +14,28 @@ namespace articula::log {
 namespace {
 std::atomic<Level> g_level{Level::Normal};
 std::mutex g_mutex;  // batch subjects log from several threads
+// The message with control characters shown as \xNN (line breaks and tabs
+// kept): a message quoting a file's bytes must not drive the terminal.
+std::string printable(const std::string& message) {
+  std::string out;
+  out.reserve(message.size());
+  for (const char ch : message) {
+    const auto c = static_cast<unsigned char>(ch);
+    if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 void print(const char* tag, const std::string& message) {
+  const std::string shown = printable(message);
   std::lock_guard<std::mutex> lock(g_mutex);
-  std::cerr << "articula: " << tag << message << '\n';
+  std::cerr << "articula: " << tag << shown << '\n';
 }
 }  // namespace
 
