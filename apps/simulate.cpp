@@ -49,7 +49,8 @@ class SimulateCommand : public cli::Command {
     nlohmann::json summary = s.toJson();
     summary["scene"] = scene_path_.string();
     summary["outputs"] = dynamics::simulationOutputs();
-    summary["provenance"] = provenanceJson({{{"scene", scene.source}}, {scene_path_}, -1});
+    // The scene by its path and SHA-256 (provenance's inputs), not a copy.
+    summary["provenance"] = provenanceJson({{}, {scene_path_}, -1});
     summary["provenance"]["coordinate_system"] = "the scene's (z up when gravity is -z)";
     summary["provenance"]["units"] = "SI: m, kg, s, N";
     writeFileAtomically(summary_path, summary.dump(2) + "\n");

@@ -13,6 +13,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -444,6 +445,42 @@ TEST(Dynamics, AFittedHeadFromFitsJsonIsAContactSurfaceInMetres) {
   const double hertz = std::pow(m * kGravity / K, 2.0 / 3.0);
   EXPECT_NEAR(depth, hertz, 1e-6 * hertz);
   EXPECT_THROW(articula::dynamics::sceneFromJson(scene("ellipsoid"), "scene", folder), articula::InputError);
+}
+
+// A misspelt or stray key is refused with its place in the scene: left
+// alone, "disipation" would have meant no damping at all.
+TEST(Dynamics, UnknownSceneKeysAreRefusedByTheirPlace) {
+  const nlohmann::json ball = nlohmann::json::parse(R"({
+    "description": "a ball in a bowl", "gravity": [0, 0, -9.81], "duration": 1,
+    "bodies": [{"name": "ball", "mass": 1.0, "inertia": [0.01, 0.01, 0.01], "position": [0.9, 0, 1.0]}],
+    "contacts": [{"body": "ball", "shape": {"model": "sphere", "radii": [0.1, 0.1, 0.1]},
+                  "against": {"cavity": {"center": [0, 0, 1.0], "radius": 1.0}},
+                  "normal_law": {"law": "hunt-crossley", "stiffness": 1e8, "dissipation": 0.1},
+                  "friction": {"dynamic": 0.01}}]})");
+  EXPECT_NO_THROW(articula::dynamics::sceneFromJson(ball, "scene"));
+  const std::vector<std::pair<std::string, std::string>> strays = {
+      {"/gravty", "scene: unknown key \"gravty\""},
+      {"/output_intervall", "scene: unknown key \"output_intervall\""},
+      {"/bodies/0/velocty", "scene bodies[0]: unknown key \"velocty\""},
+      {"/bodies/0/colour", "scene bodies[0]: unknown key \"colour\""},
+      {"/contacts/0/normal_law/disipation", "normal_law (hunt-crossley): unknown key \"disipation\""},
+      {"/contacts/0/normal_law/restitution", "normal_law (hunt-crossley): unknown key \"restitution\""},
+      {"/contacts/0/friction/statc", "friction: unknown key \"statc\""},
+      {"/contacts/0/shape/radius", "shape: unknown key \"radius\""},
+      {"/contacts/0/against/cavity/radii_mm", "against cavity: unknown key \"radii_mm\""}};
+  for (const auto& [pointer, message] : strays) {
+    nlohmann::json scene = ball;
+    scene[nlohmann::json::json_pointer(pointer)] = 1;
+    try {
+      articula::dynamics::sceneFromJson(scene, "scene");
+      ADD_FAILURE() << pointer << " was accepted";
+    } catch (const articula::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  nlohmann::json described = ball;
+  described["description"] = nlohmann::json::array({1, 2});
+  EXPECT_THROW(articula::dynamics::sceneFromJson(described, "scene"), articula::InputError);
 }
 
 }  // namespace

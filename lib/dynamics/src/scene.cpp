@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <optional>
+#include <string_view>
 
 #include "articula/core/json_file.hpp"
 #include "articula/core/error.hpp"
@@ -72,6 +74,19 @@ const json& object(const json& parent, const char* key, const std::string& where
   return *v;
 }
 
+/// Refuses a key of `object` that is none of `known`: a misspelt key
+/// ("disipation") would otherwise leave its default in force unseen.
+void onlyKeys(const json& object, const std::string& where, std::initializer_list<std::string_view> known) {
+  for (const auto& [key, value] : object.items()) {
+    bool listed = false;
+    for (std::string_view k : known) listed = listed || key == k;
+    if (listed) continue;
+    std::string expected;
+    for (std::string_view k : known) expected += (expected.empty() ? "" : ", ") + std::string(k);
+    throw InputError(where + ": unknown key \"" + excerpt(key) + "\" (expected " + expected + ")");
+  }
+}
+
 int bodyIndex(const std::string& name, const std::vector<SceneBody>& bodies) {
   for (size_t i = 0; i < bodies.size(); ++i)
     if (bodies[i].name == name) return static_cast<int>(i);
@@ -81,6 +96,8 @@ int bodyIndex(const std::string& name, const std::vector<SceneBody>& bodies) {
 SceneJoint readJoint(const json& j, const std::string& where, const std::vector<SceneBody>& earlier) {
   if (!j.is_object()) refuse(where, "joint", "an object", j);
   SceneJoint joint;
+  onlyKeys(j, where, {"type", "parent", "point_in_parent", "point_in_child", "axis", "stiffness", "damping",
+                      "rest_angle_deg", "angle_deg", "rate_deg_s"});
   if (text(j, "type", where, "revolute") != "revolute") refuse(where, "type", "revolute", j.at("type"));
   const std::string parent = text(j, "parent", where, std::nullopt);
   joint.parent = bodyIndex(parent, earlier);
@@ -102,6 +119,7 @@ SceneJoint readJoint(const json& j, const std::string& where, const std::vector<
 SceneBody readBody(const json& j, const std::string& where, const std::vector<SceneBody>& earlier) {
   if (!j.is_object()) refuse(where, "body", "an object", j);
   SceneBody b;
+  onlyKeys(j, where, {"name", "mass", "inertia", "joint", "position", "angles_deg", "velocity", "angular_velocity"});
   b.name = text(j, "name", where, std::nullopt);
   b.mass = number(j, "mass", where, std::nullopt, 1e-9, 1e9, "a mass in kg, 1e-9 to 1e9");
   b.inertia = vector3(j, "inertia", where, std::nullopt, 1e9);
@@ -129,11 +147,14 @@ ContactLaws readLaws(const json& j, const std::string& where) {
   const std::string w = where + " normal_law";
   const std::string law = text(n, "law", w, "hunt-crossley");
   if (law == "hertz") {
+    onlyKeys(n, w + " (hertz)", {"law", "stiffness", "exponent"});
     laws.normal.law = contact::NormalLaw::Hertz;
   } else if (law == "hunt-crossley") {
+    onlyKeys(n, w + " (hunt-crossley)", {"law", "stiffness", "exponent", "dissipation"});
     laws.normal.law = contact::NormalLaw::HuntCrossley;
     laws.normal.dissipation = number(n, "dissipation", w, 0.0, 0, 1e6, "a dissipation >= 0 (s/m)");
   } else if (law == "lankarani-nikravesh") {
+    onlyKeys(n, w + " (lankarani-nikravesh)", {"law", "stiffness", "exponent", "restitution", "impact_speed"});
     laws.normal.law = contact::NormalLaw::LankaraniNikravesh;
     laws.normal.restitution = number(n, "restitution", w, std::nullopt, 1e-6, 1, "a restitution in (0, 1]");
     laws.normal.impact_speed = number(n, "impact_speed", w, std::nullopt, 1e-9, 1e4, "an impact speed > 0 (m/s)");
@@ -145,6 +166,7 @@ ContactLaws readLaws(const json& j, const std::string& where) {
   if (const json* f = member(j, "friction")) {
     const std::string fw = where + " friction";
     if (!f->is_object()) refuse(where, "friction", "an object", *f);
+    onlyKeys(*f, fw, {"dynamic", "static", "viscous", "transition_speed"});
     laws.friction.dynamic = number(*f, "dynamic", fw, 0.0, 0, 10, "a coefficient of 0 to 10");
     laws.friction.static_peak = number(*f, "static", fw, laws.friction.dynamic, 0, 10, "a coefficient of 0 to 10");
     laws.friction.viscous = number(*f, "viscous", fw, 0.0, 0, 1e6, "a coefficient >= 0 (s/m)");
@@ -180,6 +202,8 @@ contact::ConvexShape readFittedShape(const json& s, const std::string& sw, const
 }
 
 contact::ConvexShape readShape(const json& s, const std::string& sw, const std::filesystem::path& folder) {
+  if (member(s, "fits")) onlyKeys(s, sw, {"model", "fits", "center", "angles_deg"});
+  else onlyKeys(s, sw, {"model", "radii", "exponents", "center", "angles_deg"});
   const std::string model = text(s, "model", sw, std::nullopt);
   if (model != "sphere" && model != "ellipsoid" && model != "superellipsoid")
     refuse(sw, "model", "sphere, ellipsoid or superellipsoid", s.at("model"));
@@ -203,6 +227,7 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
                          const std::filesystem::path& folder) {
   if (!j.is_object()) refuse(where, "contact", "an object", j);
   SceneContact c;
+  onlyKeys(j, where, {"body", "point", "shape", "against", "normal_law", "friction"});
   const std::string body = text(j, "body", where, std::nullopt);
   c.body = bodyIndex(body, bodies);
   if (c.body < 0) throw InputError(where + ": body \"" + excerpt(body) + "\" is not one of the scene's bodies");
@@ -213,9 +238,11 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   const bool centred_sphere = c.shape.quadric && c.shape.radii.minCoeff() == c.shape.radii.maxCoeff() &&
                               c.shape.center == Eigen::Vector3d::Zero();
   const json& against = object(j, "against", where);
+  onlyKeys(against, where + " against", {"plane", "cavity", "body", "shape"});
   if (const json* plane = member(against, "plane")) {
     const std::string pw = where + " against plane";
     if (!plane->is_object()) refuse(where, "against plane", "an object", *plane);
+    onlyKeys(*plane, pw, {"point", "normal"});
     c.point = vector3(*plane, "point", pw, Eigen::Vector3d::Zero());
     c.normal = vector3(*plane, "normal", pw, std::nullopt);
     if (!(c.normal.norm() > 0)) refuse(pw, "normal", "a non-zero vector", plane->at("normal"));
@@ -225,6 +252,8 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
   } else if (const json* cavity = member(against, "cavity")) {
     const std::string cw = where + " against cavity";
     if (!cavity->is_object()) refuse(where, "against cavity", "an object", *cavity);
+    onlyKeys(*cavity, cw, member(*cavity, "radii") ? std::initializer_list<std::string_view>{"center", "radii", "angles_deg"}
+                                                   : std::initializer_list<std::string_view>{"center", "radius"});
     if (!centred_sphere)
       throw InputError(cw + ": a cavity holds a sphere centred at its body's origin (shape center [0, 0, 0])");
     c.cavity = true;
@@ -274,7 +303,8 @@ SceneContact readContact(const json& j, const std::string& where, const std::vec
 Scene sceneFromJson(const json& document, const std::string& where, const std::filesystem::path& folder) {
   if (!document.is_object()) refuse(where, "scene", "a JSON object", document);
   Scene scene;
-  scene.source = document;
+  onlyKeys(document, where, {"description", "gravity", "duration", "output_interval", "integrator", "bodies", "contacts"});
+  if (const json* d = member(document, "description"); d && !d->is_string()) refuse(where, "description", "a string", *d);
   scene.gravity = vector3(document, "gravity", where, Eigen::Vector3d(0, 0, -9.81), 1e4);
   scene.duration = number(document, "duration", where, std::nullopt, 1e-9, 1e5, "a duration of up to 1e5 s");
   scene.output_interval = number(document, "output_interval", where, 0.01, 1e-9, 1e5, "an interval > 0 (s)");
@@ -283,6 +313,7 @@ Scene sceneFromJson(const json& document, const std::string& where, const std::f
   if (const json* in = member(document, "integrator")) {
     const std::string w = where + " integrator";
     if (!in->is_object()) refuse(where, "integrator", "an object", *in);
+    onlyKeys(*in, w, {"type", "accuracy"});
     const std::string type = text(*in, "type", w, "runge-kutta-merson");
     if (type == "runge-kutta-merson") scene.integrator = IntegratorKind::RungeKuttaMerson;
     else if (type == "cpodes") scene.integrator = IntegratorKind::CPodes;

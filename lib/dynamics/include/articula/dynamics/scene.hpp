@@ -70,7 +70,6 @@ struct Scene {
   double accuracy = 1e-6;
   double duration = 1;
   double output_interval = 0.01;
-  nlohmann::json source;  // the file as read, for provenance
 };
 
 /// Reads and checks a scene file; throws InputError naming the file and the
