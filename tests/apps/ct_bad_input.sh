@@ -84,4 +84,31 @@ expect 3 "no triangles" -- "$B/articula-sample" -i "$T/points-only.ply" -o "$T/s
 "$B/articula-mesh" -i "$T/head.nii.gz" -o "$T/head.vtp" -q
 expect 3 "expected at least" -- "$B/articula-sample" -i "$T/head.vtp" -o "$T/s.ply" --select sphere:0,0,0,1
 expect 2 "expected auto" -- "$B/articula-sample" -i "$T/head.vtp" -o "$T/s.ply" --select blob
+# MetaImage CTs that ITK reads without a word: cut short (raw or
+# compressed), a NaN voxel, one value everywhere. A whole one reads.
+python3 - "$T" <<'PY'
+import math, struct, sys, zlib
+n, folder = 24, sys.argv[1]
+def header(kind, extra=""):
+    return (f"ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n{extra}"
+            f"DimSize = {n} {n} {n}\nElementSpacing = 1.5 1.5 1.5\nElementType = {kind}\nElementDataFile = LOCAL\n").encode()
+ball = [1000 if math.dist((i, j, k), (12, 12, 12)) < 8 else 0 for k in range(n) for j in range(n) for i in range(n)]
+raw = struct.pack(f"<{n ** 3}h", *ball)
+open(f"{folder}/whole.mha", "wb").write(header("MET_SHORT") + raw)
+open(f"{folder}/cut.mha", "wb").write(header("MET_SHORT") + raw[: len(raw) // 2])
+packed = zlib.compress(raw)
+open(f"{folder}/cut-zlib.mha", "wb").write(header("MET_SHORT", "CompressedData = True\n") + packed[: len(packed) // 2])
+values = [float(v) for v in ball]
+values[n ** 3 // 2] = float("nan")
+open(f"{folder}/nan.mha", "wb").write(header("MET_FLOAT") + struct.pack(f"<{n ** 3}f", *values))
+open(f"{folder}/flat.mha", "wb").write(header("MET_SHORT") + struct.pack(f"<{n ** 3}h", *([-1000] * n ** 3)))
+PY
+expect 3 "announces 27648 bytes of voxel data, the file holds 13824: the file is cut short" -- \
+  "$B/articula-segment" -i "$T/cut.mha" -o "$T/l.nii.gz"
+expect 3 "compressed voxel data is damaged\|the file is cut short" -- "$B/articula-segment" -i "$T/cut-zlib.mha" -o "$T/l.nii.gz"
+expect 3 "1 of 13824 voxels are not finite numbers" -- "$B/articula-segment" -i "$T/nan.mha" -o "$T/l.nii.gz"
+expect 3 "every voxel holds the same value" -- "$B/articula-segment" -i "$T/flat.mha" -o "$T/l.nii.gz"
+test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for a damaged MetaImage"; fail=1; }
+# The whole file passes the reader's checks (its ball is too small for a head: exit 1).
+expect 1 "no femoral head found" -- "$B/articula-segment" -i "$T/whole.mha" -o "$T/l.nii.gz"
 exit $fail

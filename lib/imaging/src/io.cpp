@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -367,6 +368,28 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
 
 }  // namespace
 
+// Voxels a CT can hold: finite numbers, not all the same (a zero
+// RescaleSlope, or a series written blank, gives one value everywhere).
+void checkVoxelValues(const Volume& volume, const std::string& where) {
+  size_t non_finite = 0;
+  float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+  for (const float v : volume.voxels) {
+    if (!std::isfinite(v)) {
+      ++non_finite;
+      continue;
+    }
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (non_finite > 0)
+    throw InputError(where + ": " + std::to_string(non_finite) + " of " + std::to_string(volume.voxels.size()) +
+                     " voxels are not finite numbers (NaN or infinite): expected CT values in HU; the file is damaged "
+                     "or holds no CT");
+  if (!volume.voxels.empty() && lo == hi)
+    throw InputError(where + ": every voxel holds the same value (" + std::to_string(lo) +
+                     "): a CT of a joint varies; a RescaleSlope of 0 or a blank series gives this");
+}
+
 void checkDirection(const Eigen::Matrix3d& direction, const std::string& where) {
   const double err = (direction.transpose() * direction - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!direction.allFinite() || err > 1e-3) {
@@ -527,6 +550,7 @@ Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, Re
     volume = readImageFile<float>(input);
   }
   checkDirection(volume.geometry.direction, input.string());
+  checkVoxelValues(volume, input.string());
   if (volume.geometry.size.minCoeff() < 2)
     throw InputError("expected a 3-D volume in " + input.string() + ", found size " +
                      std::to_string(volume.geometry.size[0]) + "x" + std::to_string(volume.geometry.size[1]) + "x" +

@@ -16,6 +16,7 @@
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/imaging/image.hpp"
+#include "image_file_check.hpp"
 
 namespace articula::imaging {
 
@@ -92,6 +93,7 @@ inline itk::IOComponentEnum storedComponentType(const std::filesystem::path& pat
 template <typename T>
 Image<T> readImageFile(const std::filesystem::path& path) {
   checkNiftiFile(path);
+  checkImageDataLength(path);
   // What the file holds, before ITK reads it as 3-D (it would silently take
   // the first volume of a 4-D image and the first component of a vector).
   if (auto io = itk::ImageIOFactory::CreateImageIO(path.string().c_str(), itk::CommonEnums::IOFileMode::ReadMode)) {
