@@ -193,8 +193,11 @@ TEST(ImagingIo, NiftiHeadersPromisingMoreThanTheFileHoldsAreRefused) {
     }
   };
   const std::string voxels(4 * 4 * 4 * 2, '\0');
-  std::ofstream(dir / "ok.nii", std::ios::binary) << niftiHeader(false, 3, 4, 4, 4) + voxels;
+  std::string ok = voxels;
+  ok[0] = 1;  // a CT whose voxels all hold one value is refused on its own
+  std::ofstream(dir / "ok.nii", std::ios::binary) << niftiHeader(false, 3, 4, 4, 4) + ok;
   EXPECT_EQ(imaging::readVolume(dir / "ok.nii", {}).geometry.size, Eigen::Vector3i(4, 4, 4));
+  refused("flat.nii", niftiHeader(false, 3, 4, 4, 4) + voxels, "every voxel holds the same value");
 
   refused("analyze.nii", niftiHeader(false, 3, 26414, 122, 77, "\0\0\0\0") + voxels, "truncated");
   // Header size 348 little-endian, dim[0] valid big-endian only: nifti1_io reads big-endian dims.
