@@ -22,6 +22,11 @@ expect 3 "not found" -- "$B/articula-segment" -i "$T/missing.nii.gz" -o "$T/l.ni
 test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for bad input"; fail=1; }
 
 "$B/articula" phantom -o "$T/p" --seed 2 --spacing 1.5,1.5,2 -q
+# The folder above a series: found none there, and the series' folder named.
+mkdir -p "$T/above/study"
+cp -r "$T/p/dicom" "$T/above/study/series"
+expect 3 "found none .*DICOM files lie in $T/above/study/series (64 or more files): give that folder" -- \
+  "$B/articula-segment" -i "$T/above" -o "$T/l.nii.gz"
 # A missing slice: non-uniform spacing, named.
 cp -r "$T/p/dicom" "$T/gap"
 rm "$T/gap/slice_0020.dcm"

@@ -29,6 +29,8 @@ rc=$?
 set -e
 [ "$rc" -eq 3 ] || fail "--validate with bad inputs exited $rc, expected 3"
 grep -q "subject missing: input .* does not exist" "$tmp/validate.err" || fail "validate names the missing input"
+grep -q "subject baddicom: expected DICOM files in .*bad-dicom, found none" "$tmp/validate.err" ||
+  fail "validate names the folder without DICOM: $(cat "$tmp/validate.err")"
 [ ! -e "$tmp/study/study.csv" ] || fail "--validate ran something"
 
 start=$(date +%s.%N)

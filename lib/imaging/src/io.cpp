@@ -422,6 +422,36 @@ void refuseDamagedDicomFiles(const fs::path& folder) {
 }
 }  // namespace
 
+// Up to three folders below `folder` (three levels deep, 200 folders at
+// most) holding DICOM files, with how many: the hint when a user gives the
+// folder above a series.
+std::string dicomFoldersBelow(const fs::path& folder) {
+  std::vector<std::pair<fs::path, int>> level = {{folder, 0}}, found;
+  int visited = 0;
+  for (int depth = 0; depth <= 3 && found.size() < 3; ++depth) {
+    std::vector<std::pair<fs::path, int>> next;
+    for (const auto& [dir, unused] : level) {
+      std::error_code ec;
+      int dicom = 0, looked = 0;
+      for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        if (it->is_directory(ec) && !it->is_symlink(ec)) {
+          if (++visited <= 200) next.push_back({it->path(), 0});
+        } else if (depth > 0 && it->is_regular_file(ec) && looked < 64) {
+          ++looked;
+          dicom += checkDicomFile(it->path()).kind != DicomFileKind::NotDicom ? 1 : 0;
+        }
+      }
+      if (dicom > 0 && found.size() < 3) found.push_back({dir, dicom});
+    }
+    level = std::move(next);
+  }
+  std::string hint;
+  for (const auto& [dir, files] : found)
+    hint += (hint.empty() ? "; DICOM files lie in " : ", in ") + dir.string() + " (" +
+            (files >= 64 ? "64 or more" : std::to_string(files)) + " files)";
+  return hint.empty() ? "" : hint + ": give that folder as the input";
+}
+
 std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
   if (!fs::is_directory(folder)) throw InputError("expected a DICOM folder, found no folder at " + folder.string());
   if (fs::is_empty(folder)) throw InputError("expected DICOM files in " + folder.string() + ", found an empty folder");
@@ -446,7 +476,8 @@ std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
     throw InputError("could not scan " + folder.string() + " for DICOM files: " + e.GetDescription());
   }
   if (out.empty())
-    throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)");
+    throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)" +
+                     dicomFoldersBelow(folder));
   return out;
 }
 

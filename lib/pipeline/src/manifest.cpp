@@ -5,6 +5,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
 #include "articula/core/csv.hpp"
+#include "articula/imaging/io.hpp"
 
 namespace articula::pipeline {
 
@@ -96,7 +97,16 @@ std::vector<std::string> checkSubjectInput(const Subject& s) {
         any = true;
         break;
       }
-    if (!any) problems.push_back("input folder '" + s.input.string() + "' holds no files (expected a DICOM series)");
+    if (!any) {
+      problems.push_back("input folder '" + s.input.string() + "' holds no files (expected a DICOM series)");
+    } else {
+      // The series' headers, as the run will scan them (no voxel is read).
+      try {
+        imaging::listDicomSeries(s.input);
+      } catch (const Error& e) {
+        problems.push_back(e.what());
+      }
+    }
   } else {
     const std::string name = s.input.filename().string();
     auto ends = [&name](const std::string& suffix) {
