@@ -23,7 +23,7 @@ struct NormalForceLaw {
   double stiffness = 0;     // K, force / length^exponent
   double exponent = 1.5;    // n: 1.5 for Hertzian point contact, 1 for a linear spring
   double dissipation = 0;   // Hunt-Crossley c (time / length); see huntCrossleyDissipation
-  double restitution = 1;   // Lankarani-Nikravesh e, in (0, 1]
+  double restitution = 1;   // Lankarani-Nikravesh nominal e, in (0, 1] (a free impact rebounds faster when e < ~0.9)
   double impact_speed = 0;  // Lankarani-Nikravesh v0 > 0: the approach speed when the contact began
   /// Throws InvalidParameter naming the first value out of its range.
   void validate() const;
