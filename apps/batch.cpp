@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -52,7 +53,7 @@ class BatchCommand : public cli::Command {
     const auto subjects = pipeline::readManifest(manifest_);
     int problems = 0;
     for (const auto& s : subjects)
-      for (const auto& p : pipeline::checkSubjectInput(s)) {
+      for (const auto& p : pipeline::checkSubjectInput(s, validate_only_)) {
         log::warn(manifest_.string() + ":" + std::to_string(s.line) + ": subject " + s.id + ": " + p);
         ++problems;
       }
@@ -109,11 +110,10 @@ class BatchCommand : public cli::Command {
     const std::optional<nlohmann::json> earlier = readJsonFileIfValid(study_dir_ / "study.json");
     const bool ours = earlier && earlier->contains("provenance") && earlier->contains("subjects");
     if (ours) return;
-    std::string others;
+    std::vector<std::string> others;
     for (const char* table : {"study.csv", "study_summary.csv", "study_status.csv", "study.json", "study.svg", "study.html"})
-      if (fs::exists(study_dir_ / table)) others += (others.empty() ? "" : ", ") + (study_dir_ / table).string();
-    if (!others.empty())
-      throw UsageError("refusing to overwrite " + others + ", which articula batch did not write (use --force, or another --output)");
+      if (fs::exists(study_dir_ / table)) others.push_back((study_dir_ / table).string());
+    cli::refuseToOverwrite(others, ", which articula batch did not write (use --force, or another --output)");
   }
 
   fs::path manifest_, study_dir_, subject_config_;

@@ -135,11 +135,7 @@ class PhantomCommand : public cli::Command {
       }
       if (!slices.empty()) existing.push_back(dicom.string() + "/ (" + std::to_string(slices.size()) + " slices)");
     }
-    if (!force && !existing.empty()) {
-      std::string list;
-      for (const auto& e : existing) list += (list.empty() ? "" : ", ") + e;
-      throw UsageError("refusing to overwrite " + list + " (use --force)");
-    }
+    if (!force) cli::refuseToOverwrite(existing, " (use --force)");
     return slices;
   }
 

@@ -204,10 +204,7 @@ class RunCommand : public cli::Command {
         if (!ours) others.push_back((output_ / out).string());
       }
     }
-    if (others.empty()) return;
-    std::string list;
-    for (const auto& o : others) list += (list.empty() ? "" : ", ") + o;
-    throw UsageError("refusing to overwrite " + list + ", which articula run did not write (use --force, or another --output)");
+    cli::refuseToOverwrite(others, ", which articula run did not write (use --force, or another --output)");
   }
 
   static bool upToDate(const Plan& plan, const json& stamp, const fs::path& stamp_path) {

@@ -168,6 +168,13 @@ int runCommandInProcess(const std::string& name, const std::vector<std::string>&
   return rc;
 }
 
+void refuseToOverwrite(const std::vector<std::string>& existing, const std::string& advice) {
+  if (existing.empty()) return;
+  std::string list;
+  for (const auto& file : existing) list += (list.empty() ? "" : ", ") + file;
+  throw UsageError("refusing to overwrite " + list + advice);
+}
+
 std::string argumentProblem(const std::string& name, const std::vector<std::string>& args) {
   auto command = createCommand(name);
   CLI::App app;

@@ -85,7 +85,7 @@ std::vector<Subject> readManifest(const fs::path& manifest) {
   return subjects;
 }
 
-std::vector<std::string> checkSubjectInput(const Subject& s) {
+std::vector<std::string> checkSubjectInput(const Subject& s, bool scan_series) {
   std::vector<std::string> problems;
   std::error_code ec;
   if (!fs::exists(s.input, ec)) {
@@ -99,8 +99,7 @@ std::vector<std::string> checkSubjectInput(const Subject& s) {
       }
     if (!any) {
       problems.push_back("input folder '" + s.input.string() + "' holds no files (expected a DICOM series)");
-    } else {
-      // The series' headers, as the run will scan them (no voxel is read).
+    } else if (scan_series) {
       try {
         imaging::listDicomSeries(s.input);
       } catch (const Error& e) {

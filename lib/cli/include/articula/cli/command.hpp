@@ -79,6 +79,10 @@ int runCommandInProcess(const std::string& name, const std::vector<std::string>&
 /// type or out of its declared range), or an empty string when they parse.
 std::string argumentProblem(const std::string& name, const std::vector<std::string>& args);
 
+/// Throws UsageError "refusing to overwrite A, B<advice>" when `existing`
+/// (outputs found before any work) is not empty: every one named at once.
+void refuseToOverwrite(const std::vector<std::string>& existing, const std::string& advice);
+
 /// Prints a JSON summary on stdout (for --json).
 void printJson(const nlohmann::json& summary);
 

@@ -25,6 +25,9 @@ std::vector<Subject> readManifest(const std::filesystem::path& manifest);
 
 /// Problems with a subject's input that would make it fail (missing path,
 /// unreadable, an empty folder, an unknown extension); empty if none.
-std::vector<std::string> checkSubjectInput(const Subject& subject);
+/// With `scan_series`, a DICOM folder's series are scanned as the run will
+/// (every file walked, no voxel read): for --validate, not for every batch,
+/// whose runs scan them anyway.
+std::vector<std::string> checkSubjectInput(const Subject& subject, bool scan_series = false);
 
 }  // namespace articula::pipeline
