@@ -1,15 +1,26 @@
 #include "dicom_check.hpp"
 
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <fstream>
+#include <iomanip>
+#include <sstream>
 #include <stdexcept>
+#include <unistd.h>
+
+#include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 
 namespace articula::imaging {
 
 namespace {
 
 constexpr std::uint32_t kUndefinedLength = 0xFFFFFFFFu;
+constexpr std::uint32_t kPixelData = 0x7FE00010u;
 constexpr std::uint32_t kItem = 0xFFFEE000u, kItemEnd = 0xFFFEE00Du, kSequenceEnd = 0xFFFEE0DDu;
 constexpr int kMaxNesting = 64;  // deeper is no real file, and would only grow the stack
 
@@ -73,7 +84,9 @@ class Walker {
       length = read32();
     }
     if (length == kUndefinedLength) {
+      if (depth == 0 && header && tag == kPixelData) header->pixel_data_bytes = DicomSliceHeader::kEncapsulated;
       items(depth + 1, tag, start);
+    } else if (depth == 0 && header && capture(tag, length, start)) {
     } else {
       if (value && length <= 256) {
         need(length, tag, start);
@@ -132,6 +145,40 @@ class Walker {
     pos_ += n;
     return out;
   }
+  // The slice header's elements of the top-level data set (nested ones, in
+  // sequences, describe other things).
+  bool capture(std::uint32_t tag, std::uint32_t length, std::uint64_t start) {
+    std::string* text = nullptr;
+    long* count = nullptr;
+    switch (tag) {
+      case 0x00200032u: text = &header->position; break;
+      case 0x00200037u: text = &header->orientation; break;
+      case 0x00280030u: text = &header->pixel_spacing; break;
+      case 0x00281053u: text = &header->rescale_slope; break;
+      case 0x00280008u: text = &header->frames; break;
+      case 0x00280010u: count = &header->rows; break;
+      case 0x00280011u: count = &header->columns; break;
+      case 0x00280100u: count = &header->bits_allocated; break;
+      case 0x00280002u: count = &header->samples_per_pixel; break;
+      case kPixelData:
+        header->pixel_data_bytes = length;
+        skip(length, tag, start);
+        return true;
+      default: return false;
+    }
+    if (text && length <= 256) {
+      need(length, tag, start);
+      *text = bytes(length);
+      while (!text->empty() && (text->back() == ' ' || text->back() == '\0')) text->pop_back();
+      return true;
+    }
+    if (count && length == 2) {
+      *count = static_cast<long>(read16());
+      return true;
+    }
+    return false;
+  }
+
   std::uint32_t number(int n) {
     const std::string b = bytes(static_cast<std::uint64_t>(n));
     std::uint32_t v = 0;
@@ -147,11 +194,38 @@ class Walker {
 
   std::ifstream& in_;
   std::uint64_t size_;
+
+ public:
+  DicomSliceHeader* header = nullptr;  // where to note the slice header, if anywhere
+
+ private:
   std::uint64_t pos_ = 0;
 
  public:
   void seek(std::uint64_t to) { pos_ = to; }
 };
+
+// A data set with no preamble (as old writers and some archives store
+// them), which GDCM still reads: walked from its first byte, in implicit or
+// explicit VR little endian as its first element shows, for its slice header.
+// Anything else is no DICOM file this check knows.
+void walkWithoutPreamble(std::ifstream& in, std::uint64_t size, DicomSliceHeader& header) {
+  unsigned char first[6] = {};
+  if (size < 8 || !in.seekg(0) || !in.read(reinterpret_cast<char*>(first), 6)) return;
+  const unsigned group = first[0] | unsigned(first[1]) << 8;
+  if (group != 0x0002 && group != 0x0008) return;
+  DicomSliceHeader found;
+  try {
+    Walker walk(in, size);
+    walk.header = &found;
+    walk.explicit_vr = std::isupper(first[4]) && std::isupper(first[5]);
+    while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
+  } catch (const Broken&) {
+    return;
+  }
+  found.read = true;
+  header = found;
+}
 
 }  // namespace
 
@@ -166,9 +240,14 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
     return result;
   }
   char magic[4] = {};
-  if (size < 132 || !in.seekg(128) || !in.read(magic, 4) || std::string(magic, 4) != "DICM") return result;  // NotDicom
+  if (size < 132 || !in.seekg(128) || !in.read(magic, 4) || std::string(magic, 4) != "DICM") {
+    in.clear();
+    walkWithoutPreamble(in, size, result.header);
+    return result;  // NotDicom
+  }
   try {
     Walker walk(in, size);
+    walk.header = &result.header;
     walk.seek(132);
     // The meta header (group 0002) is explicit VR little endian; its transfer
     // syntax says how the data set after it is encoded.
@@ -183,18 +262,190 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
     while (!syntax.empty() && (syntax.back() == '\0' || syntax.back() == ' ')) syntax.pop_back();
     if (syntax == "1.2.840.10008.1.2.1.99") {  // deflated: the data set is a zlib stream, not walked
       result.kind = DicomFileKind::Complete;
-      return result;
+      return result;  // header.read stays false: the series check refuses it by name
     }
     walk.explicit_vr = syntax != "1.2.840.10008.1.2";
     walk.big_endian = syntax == "1.2.840.10008.1.2.2";
     // Zero bytes after the last element are padding some writers leave; GDCM stops there too.
     while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
     result.kind = DicomFileKind::Complete;
+    result.header.read = syntax != "1.2.840.10008.1.2.1.99";
   } catch (const Broken& e) {
     result.kind = DicomFileKind::Damaged;
     result.problem = e.what();
   }
   return result;
+}
+
+}  // namespace articula::imaging
+
+namespace articula::imaging {
+
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+std::vector<double> numbers(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, '\\')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (end == item.c_str() || !std::isfinite(v)) return {};
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::string number(double v) {
+  std::ostringstream out;
+  out << std::setprecision(7) << v;
+  return out.str();
+}
+
+// A multi-valued element as numbers, "(1, 0, 0)": its text shows DICOM's
+// backslash separators escaped.
+std::string shown(const std::string& text) {
+  const std::vector<double> values = numbers(text);
+  if (values.empty()) return "'" + excerpt(text) + "'";
+  if (values.size() == 1) return number(values[0]);
+  std::ostringstream out;
+  out << std::setprecision(7) << '(';
+  for (size_t i = 0; i < values.size(); ++i) out << (i ? ", " : "") << values[i];
+  out << ')';
+  return out.str();
+}
+
+std::string name(const std::string& file) { return excerpt(std::filesystem::path(file).filename().string()); }
+
+std::string gigabytes(double bytes) {
+  std::ostringstream text;
+  text << std::setprecision(3) << bytes / 1e9 << " GB";
+  return text.str();
+}
+
+}  // namespace
+
+void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector<DicomSliceHeader>& headers) {
+  const std::string series = "DICOM series in " + excerpt(std::filesystem::path(files.at(0)).parent_path().string());
+  for (size_t k = 0; k < files.size(); ++k)
+    if (!headers[k].read)
+      throw InputError(series + ": the header of " + name(files[k]) +
+                       " could not be checked (no DICOM preamble, or a deflated data set); expected a DICOM file "
+                       "with a preamble: convert the series, for example with gdcmconv --raw");
+  const DicomSliceHeader& first = headers[0];
+  const auto where = [&](size_t k) { return name(files[k]) + " (slice " + std::to_string(k + 1) + " of " +
+                                            std::to_string(files.size()) + ")"; };
+  if (first.rows <= 0 || first.columns <= 0)
+    throw InputError(series + ": " + where(0) + " has no Rows (0028,0010) or Columns (0028,0011); expected an image");
+  const std::vector<double> orientation = numbers(first.orientation);
+  if (orientation.size() != 6)
+    throw InputError(series + ": expected six numbers in Image Orientation Patient (0020,0037) of " + where(0) +
+                     ", found " + shown(first.orientation));
+  const std::vector<double> spacing = numbers(first.pixel_spacing);
+  if (spacing.size() != 2 || !(spacing[0] > 0 && spacing[1] > 0))
+    throw InputError(series + ": expected two positive numbers in Pixel Spacing (0028,0030) of " + where(0) +
+                     ", found " + shown(first.pixel_spacing));
+  const Vec3 row{orientation[0], orientation[1], orientation[2]}, column{orientation[3], orientation[4], orientation[5]};
+  Vec3 normal{row[1] * column[2] - row[2] * column[1], row[2] * column[0] - row[0] * column[2],
+              row[0] * column[1] - row[1] * column[0]};
+  const double length = std::sqrt(dot(normal, normal));
+  if (!(length > 0.5)) throw InputError(series + ": the orientation of " + where(0) + " has parallel row and column");
+  for (double& v : normal) v /= length;
+
+  std::vector<Vec3> positions;
+  double pixel_bytes = 0;
+  for (size_t k = 0; k < files.size(); ++k) {
+    const DicomSliceHeader& h = headers[k];
+    if (h.rows != first.rows || h.columns != first.columns)
+      throw InputError(series + ": " + where(k) + " is " + std::to_string(h.rows) + " x " + std::to_string(h.columns) +
+                       " pixels (rows x columns), the first slice " + std::to_string(first.rows) + " x " +
+                       std::to_string(first.columns) + ": a volume needs one size; remove the slices of another image");
+    if (h.bits_allocated != first.bits_allocated || h.samples_per_pixel != first.samples_per_pixel)
+      throw InputError(series + ": " + where(k) + " stores " + std::to_string(h.bits_allocated) + " bits x " +
+                       std::to_string(h.samples_per_pixel) + " samples per pixel, the first slice " +
+                       std::to_string(first.bits_allocated) + " x " + std::to_string(first.samples_per_pixel));
+    const std::vector<double> o = numbers(h.orientation);
+    double turn = o.size() == 6 ? 0 : 1;
+    for (size_t i = 0; i < o.size() && i < 6; ++i) turn = std::max(turn, std::fabs(o[i] - orientation[i]));
+    if (turn > 1e-4)
+      throw InputError(series + ": " + where(k) + " has Image Orientation Patient " + shown(h.orientation) +
+                       ", the first slice " + shown(first.orientation) +
+                       ": ITK would place every slice in the first one's orientation; remove the slices of another "
+                       "image or resample the series");
+    const std::vector<double> s = numbers(h.pixel_spacing);
+    if (s.size() != 2 || std::fabs(s[0] - spacing[0]) > 1e-4 * spacing[0] ||
+        std::fabs(s[1] - spacing[1]) > 1e-4 * spacing[1])
+      throw InputError(series + ": " + where(k) + " has Pixel Spacing " + shown(h.pixel_spacing) +
+                       " mm, the first slice " + shown(first.pixel_spacing) +
+                       ": ITK would use the first slice's spacing for all; remove the slices of another image");
+    if (!h.rescale_slope.empty()) {
+      const std::vector<double> slope = numbers(h.rescale_slope);
+      if (slope.size() != 1 || slope[0] == 0)
+        throw InputError(series + ": " + where(k) + " has Rescale Slope (0028,1053) " + shown(h.rescale_slope) +
+                         "; expected a non-zero number (a slope of 0 makes every voxel of the slice one value)");
+    }
+    const std::vector<double> frames_text = numbers(h.frames);
+    const double frames = frames_text.size() == 1 && frames_text[0] >= 1 ? frames_text[0] : 1;
+    const double bytes = double(h.rows) * double(h.columns) * frames * std::max(1L, h.samples_per_pixel) *
+                         std::max(1.0, double(h.bits_allocated) / 8);
+    if (h.pixel_data_bytes == -1)
+      throw InputError(series + ": " + where(k) + " holds no Pixel Data (7FE0,0010); expected an image in every slice");
+    if (h.pixel_data_bytes >= 0 && double(h.pixel_data_bytes) < bytes)
+      throw InputError(series + ": " + where(k) + " holds " + std::to_string(h.pixel_data_bytes) +
+                       " bytes of pixel data, its header announces " + std::to_string(h.rows) + " x " +
+                       std::to_string(h.columns) + " pixels of " + std::to_string(h.bits_allocated) + " bits (" +
+                       std::to_string(static_cast<long long>(bytes)) +
+                       " bytes): the slice is cut or damaged; replace it or export the series again");
+    pixel_bytes += double(h.rows) * double(h.columns) * frames;
+    const std::vector<double> p = numbers(h.position);
+    if (p.size() != 3)
+      throw InputError(series + ": expected three numbers in Image Position Patient (0020,0032) of " + where(k) +
+                       ", found " + shown(h.position));
+    positions.push_back({p[0], p[1], p[2]});
+  }
+
+  // The volume as ITK will hold it (float voxels, and a copy): refused before
+  // ITK allocates it when this machine cannot, rather than swapping or dying.
+  const double needed = pixel_bytes * sizeof(float) * 2;
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (memory > 0 && needed > memory)
+    throw InputError(series + ": the slices announce " + std::to_string(static_cast<long long>(pixel_bytes)) +
+                     " voxels (" + std::to_string(first.rows) + " x " + std::to_string(first.columns) + " x " +
+                     std::to_string(files.size()) + "), " + gigabytes(needed) + " to read, more than this machine's " +
+                     gigabytes(memory) + "; check the slices' Rows and Columns, or crop the series");
+
+  // Each slice where the series' line puts it: ITK places slice k at the
+  // first slice's position plus k gaps along the line to the last, and
+  // ignores the position each slice states.
+  if (positions.size() < 2) return;
+  std::vector<std::pair<double, size_t>> along;
+  for (size_t k = 0; k < positions.size(); ++k) along.emplace_back(dot(positions[k], normal), k);
+  std::sort(along.begin(), along.end());
+  for (size_t i = 1; i < along.size(); ++i)
+    if (along[i].first - along[i - 1].first < 1e-3)
+      throw InputError(series + ": " + where(along[i - 1].second) + " and " + where(along[i].second) +
+                       " lie at one position along the slice normal (a duplicated slice?); keep one of them");
+  const Vec3 span{positions.back()[0] - positions[0][0], positions.back()[1] - positions[0][1],
+                  positions.back()[2] - positions[0][2]};
+  const double along_span = dot(span, normal);
+  const double tolerance = 0.25 * std::min(spacing[0], spacing[1]);
+  for (size_t k = 1; k < positions.size(); ++k) {
+    const Vec3 d{positions[k][0] - positions[0][0], positions[k][1] - positions[0][1], positions[k][2] - positions[0][2]};
+    if (along_span == 0) continue;
+    const double t = dot(d, normal) / along_span;
+    const double off = std::hypot(dot(d, row) - t * dot(span, row), dot(d, column) - t * dot(span, column));
+    if (off > tolerance) {
+      std::ostringstream m;
+      m << series << ": " << where(k) << " lies " << std::setprecision(3) << off
+        << " mm beside the line from the first slice to the last (Image Position Patient " << shown(headers[k].position)
+        << "); ITK would place it on that line. Slices shifted in-plane are no single volume: export the series again";
+      throw InputError(m.str());
+    }
+  }
 }
 
 }  // namespace articula::imaging

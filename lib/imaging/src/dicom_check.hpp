@@ -7,8 +7,10 @@
 // implicit VR, either byte order, sequences and encapsulated pixel data of
 // undefined length) without decoding any value, and asks only whether each
 // element fits in the file.
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace articula::imaging {
 
@@ -18,11 +20,31 @@ enum class DicomFileKind {
   NotDicom,     // no preamble: left to GDCM, which skips what it cannot read
 };
 
+/// What a slice's top-level data set says about its place and its pixels,
+/// as written (empty text or -1 where the element is absent).
+struct DicomSliceHeader {
+  bool read = false;  // the data set was walked to its end
+  std::string position, orientation, pixel_spacing, rescale_slope, frames;  // DS/IS text
+  long rows = -1, columns = -1, bits_allocated = -1, samples_per_pixel = -1;
+  static constexpr std::int64_t kEncapsulated = -2;
+  std::int64_t pixel_data_bytes = -1;  // -1: no Pixel Data; kEncapsulated: compressed fragments
+};
+
 struct DicomFileCheck {
   DicomFileKind kind = DicomFileKind::NotDicom;
   std::string problem;  // for Damaged: where and what, e.g. "element (7FE0,0010) at byte 1164 needs 10240 bytes, 36 remain"
+  DicomSliceHeader header;
 };
 
 DicomFileCheck checkDicomFile(const std::filesystem::path& file);
+
+/// Every slice of a series against the first, before ITK assembles them: ITK
+/// takes the size, spacing and orientation of the first slice (and positions
+/// along the slice normal) for all, and fills what a slice lacks. Refuses
+/// (InputError, the file named) slices whose rows, columns, bits, orientation,
+/// pixel spacing or in-plane position differ, pixel data shorter than its
+/// header announces, a zero rescale slope, duplicated positions, and a volume
+/// larger than this machine's memory.
+void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector<DicomSliceHeader>& headers);
 
 }  // namespace articula::imaging

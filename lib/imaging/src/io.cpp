@@ -11,6 +11,7 @@
 #include <vector>
 #include <unistd.h>
 
+#include <gdcmTrace.h>
 #include <gdcmUIDGenerator.h>
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
@@ -347,6 +348,9 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
   // the first, so "" names the series of empty UID exactly.
   const std::vector<std::string> files = names->GetFileNames(chosen->uid == kEmptySeriesUid ? "" : chosen->uid);
   noteUnreadableFiles(folder, *names, report);
+  std::vector<DicomSliceHeader> headers;
+  for (const std::string& file : files) headers.push_back(checkDicomFile(file).header);
+  checkSeriesHeaders(files, headers);
   using ReaderType = itk::ImageSeriesReader<itk::Image<float, 3>>;
   auto reader = ReaderType::New();
   auto io = itk::GDCMImageIO::New();
@@ -453,6 +457,11 @@ std::string dicomFoldersBelow(const fs::path& folder) {
 }
 
 std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
+  // GDCM prints its own errors and warnings (a position shared by two slices,
+  // a tag it cannot parse) as raw lines; the checks here name the file and say
+  // what to do instead.
+  gdcm::Trace::ErrorOff();
+  gdcm::Trace::WarningOff();
   if (!fs::is_directory(folder)) throw InputError("expected a DICOM folder, found no folder at " + folder.string());
   if (fs::is_empty(folder)) throw InputError("expected DICOM files in " + folder.string() + ", found an empty folder");
   refuseDamagedDicomFiles(folder);
@@ -582,8 +591,10 @@ Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, Re
   }
   checkDirection(volume.geometry.direction, input.string());
   checkVoxelValues(volume, input.string());
-  if (volume.geometry.size.minCoeff() < 2)
-    throw InputError("expected a 3-D volume in " + input.string() + ", found size " +
+  // The head search smooths the volume with ITK's recursive Gaussian, which
+  // needs four voxels along each axis; a joint needs many more.
+  if (volume.geometry.size.minCoeff() < 4)
+    throw InputError("expected a 3-D volume of at least 4 voxels along each axis in " + input.string() + ", found size " +
                      std::to_string(volume.geometry.size[0]) + "x" + std::to_string(volume.geometry.size[1]) + "x" +
                      std::to_string(volume.geometry.size[2]));
   return volume;
