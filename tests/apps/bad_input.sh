@@ -112,6 +112,7 @@ struct.pack_into("<8h", hdr, 40, len(dims), *(dims + [1] * (7 - len(dims))))
 struct.pack_into("<hh", hdr, 70, 4, 16)
 struct.pack_into("<8f", hdr, 76, 1.0, *(pixdim + [1.0] * (7 - len(pixdim))))
 struct.pack_into("<ff", hdr, 108, 352.0, 1.0)
+struct.pack_into("<h", hdr, 252, 1)  # qform_code: scanner; quaternion and offsets 0 (identity)
 hdr[344:348] = b"n+1\0"
 n = 1
 for d in dims: n *= d
@@ -143,6 +144,31 @@ PY
   expect_rc 3 timeout 60 "$A" segment -i "$tmp/bad-srow.nii" -o "$tmp/srow-label.nii.gz"
   grep -q "orientation (pixdim\[0\], quatern, qoffset, srow) holds .* at byte 280" "$tmp/err" || fail "srow $value: $(cat "$tmp/err")"
 done
+
+# Voxels with no place in the patient (no qform, no sform), or two places
+# (an sform that mirrors the qform: a right hip read as a left one by some
+# tools); a matching sform passes to the next check (one value everywhere).
+place() {  # place PATH QFORM_CODE SFORM_CODE SROW_X0
+  python3 - "$@" <<'PY'
+import struct, sys
+b = bytearray(open(sys.argv[1], "rb").read())
+struct.pack_into("<hh", b, 252, int(sys.argv[2]), int(sys.argv[3]))
+struct.pack_into("<12f", b, 280, float(sys.argv[4]), 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0)
+open(sys.argv[1], "wb").write(b)
+PY
+}
+nifti "$tmp/placed.nii" 8,8,8 1,1,1
+place "$tmp/placed.nii" 0 0 1
+expect_rc 3 "$A" segment -i "$tmp/placed.nii" -o "$tmp/placed-label.nii.gz"
+grep -q "NIfTI header states no orientation (qform_code and sform_code are 0)" "$tmp/err" || fail "no orientation: $(cat "$tmp/err")"
+place "$tmp/placed.nii" 1 1 -1
+expect_rc 3 "$A" segment -i "$tmp/placed.nii" -o "$tmp/placed-label.nii.gz"
+grep -q "qform and its sform put a corner of the volume 14 mm apart (one mirrors the other)" "$tmp/err" ||
+  fail "sform mirroring qform: $(cat "$tmp/err")"
+place "$tmp/placed.nii" 1 1 1
+expect_rc 3 "$A" segment -i "$tmp/placed.nii" -o "$tmp/placed-label.nii.gz"
+grep -q "every voxel holds the same value" "$tmp/err" || fail "matching sform: $(cat "$tmp/err")"
+[ ! -e "$tmp/placed-label.nii.gz" ] || fail "a label was written for a NIfTI without a place"
 
 # Ranges checked before any work; an unknown command is one, --help or not.
 expect_rc 2 "$A" segment -i "$tmp/4d.nii" -o "$tmp/r.nii.gz" --max-radius 1e6

@@ -121,6 +121,7 @@ struct.pack_into("<hh", h, 70, 2, 8)
 struct.pack_into("<8f", h, 76, 1, 1, 1, 1, 0, 0, 0, 0)
 struct.pack_into("<f", h, 108, 352.0)
 struct.pack_into("<f", h, 112, 1.0)
+struct.pack_into("<h", h, 252, 1)  # qform_code: scanner, identity
 h[344:348] = b"n+1\0"
 gzip.open(sys.argv[1], "wb").write(bytes(h) + b"\0" * 4 + b"\0" * 64)
 PY

@@ -173,6 +173,7 @@ std::string niftiHeader(bool big, std::int16_t dim0, std::int16_t nx, std::int16
   for (int i = 0; i < 8; ++i) put(76 + 4 * i, 1.0f);
   put(108, 352.0f);
   put(112, 1.0f);
+  put(252, std::int16_t{1});  // qform_code: scanner; quaternion and offsets 0 (identity)
   std::memcpy(&h[344], magic, 4);
   return h;
 }

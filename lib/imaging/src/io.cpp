@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -57,6 +58,55 @@ std::vector<double> parseNumbers(const std::string& text) {
     }
   }
   return out;
+}
+
+// Where a NIfTI header puts its voxels, as its qform and its sform: empty
+// when they agree (or only one is set), the problem otherwise. Without either,
+// ITK falls back to Analyze's convention (no origin, no orientation), and a
+// header whose two transforms disagree reads differently in different tools:
+// a right hip may read as a left one.
+struct NiftiPlacement {
+  int qform_code = 0, sform_code = 0;
+  double pixdim[4] = {};  // qfac, then the voxel sizes
+  double quatern[6] = {};  // b, c, d, then the offsets x, y, z
+  double srow[12] = {};
+  double dims[3] = {};
+};
+
+std::string niftiPlacementProblem(const NiftiPlacement& n) {
+  if (n.qform_code <= 0 && n.sform_code <= 0)
+    return "states no orientation (qform_code and sform_code are 0), so its voxels have no place in the patient "
+           "(no origin, no left or right); expected a qform or an sform: convert the DICOM series again (for "
+           "example with dcm2niix) or set the transform with the tool that wrote the file";
+  if (n.qform_code <= 0 || n.sform_code <= 0) return "";
+  const double b = n.quatern[0], c = n.quatern[1], d = n.quatern[2];
+  const double a = std::sqrt(std::max(0.0, 1 - (b * b + c * c + d * d)));
+  const Eigen::Matrix3d rotation{{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
+                                 {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
+                                 {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
+  const double qfac = n.pixdim[0] < 0 ? -1 : 1;
+  const Eigen::Matrix3d q = rotation * Eigen::Vector3d(n.pixdim[1], n.pixdim[2], qfac * n.pixdim[3]).asDiagonal();
+  const Eigen::Vector3d q_origin(n.quatern[3], n.quatern[4], n.quatern[5]);
+  Eigen::Matrix3d s;
+  Eigen::Vector3d s_origin;
+  for (int r = 0; r < 3; ++r) {
+    s.row(r) << n.srow[4 * r], n.srow[4 * r + 1], n.srow[4 * r + 2];
+    s_origin[r] = n.srow[4 * r + 3];
+  }
+  double apart = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d index((corner & 1) ? n.dims[0] - 1 : 0, (corner & 2) ? n.dims[1] - 1 : 0,
+                                (corner & 4) ? n.dims[2] - 1 : 0);
+    apart = std::max(apart, (q * index + q_origin - (s * index + s_origin)).norm());
+  }
+  const double voxel = std::min({std::fabs(n.pixdim[1]), std::fabs(n.pixdim[2]), std::fabs(n.pixdim[3])});
+  if (!(apart > 0.5 * voxel)) return "";
+  std::ostringstream m;
+  m << std::setprecision(4) << "places its voxels two ways: its qform and its sform put a corner of the volume "
+    << apart << " mm apart" << (q.determinant() * s.determinant() < 0 ? " (one mirrors the other)" : "")
+    << ", and tools differ in which they use; expected transforms that agree: rewrite the header with the right "
+       "one in both (for example nibabel's img.set_qform(img.get_sform()))";
+  return m.str();
 }
 
 }  // namespace
@@ -143,6 +193,17 @@ void checkNiftiFile(const fs::path& path) {
                          std::to_string(real(at)) + " at byte " + std::to_string(at) +
                          "; expected finite numbers of at most 1e6 in size");
       }
+    NiftiPlacement placement;
+    placement.qform_code = v1 ? static_cast<std::int16_t>(bytes(252, 2, swap)) : static_cast<std::int32_t>(bytes(344, 4, swap));
+    placement.sform_code = v1 ? static_cast<std::int16_t>(bytes(254, 2, swap)) : static_cast<std::int32_t>(bytes(348, 4, swap));
+    for (int i = 0; i < 4; ++i) placement.pixdim[i] = real((v1 ? 76 : 104) + width * i);
+    for (int k = 0; k < 6; ++k) placement.quatern[k] = real((v1 ? 256 : 352) + width * k);
+    for (int k = 0; k < 12; ++k) placement.srow[k] = real((v1 ? 256 : 352) + width * (6 + k));
+    for (int i = 0; i < 3; ++i) placement.dims[i] = std::max(dim(i + 1), 1.0);
+    if (const std::string problem = niftiPlacementProblem(placement); !problem.empty()) {
+      gzclose(file);
+      throw InputError(path.string() + ": the NIfTI header " + problem);
+    }
     // A .nii file must hold all its voxels: ITK allocates the whole image from
     // the header before it reads any voxel (a header of 10^9 voxels in a file
     // of a few bytes asked for gigabytes), and it reads a truncated file (or a
