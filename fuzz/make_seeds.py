@@ -277,6 +277,84 @@ def nifti_seeds():
         write("fuzz_nifti", name + ".nii.gz", b"\x01" + gzip.compress(data, mtime=0))
 
 
+# ---- DICOM (fuzz_dicom: two slices, the first's length in two bytes) ---------------------------
+
+
+def dicom_slice(z, syntax="1.2.840.10008.1.2", preamble=True, rows=4, columns=4, encapsulated=False):
+    explicit = syntax != "1.2.840.10008.1.2"
+    big = syntax == "1.2.840.10008.1.2.2"
+    order = ">" if big else "<"
+
+    def element(group, elem, vr, value, meta=False):
+        if isinstance(value, str):
+            value = value.encode()
+            if len(value) % 2:
+                value += b"\0" if vr == "UI" else b" "
+        o = "<" if meta else order
+        tag = struct.pack(o + "HH", group, elem)
+        if meta or explicit:
+            if vr in ("OB", "OW", "SQ", "UN", "UT"):
+                return tag + vr.encode() + b"\0\0" + struct.pack(o + "I", len(value)) + value
+            return tag + vr.encode() + struct.pack(o + "H", len(value)) + value
+        return tag + struct.pack(o + "I", len(value)) + value
+
+    def us(v):
+        return struct.pack(order + "H", v)
+
+    uid = "1.2.826.0.1.3680043.2.1143.1"
+    meta_body = (element(2, 0x1, "OB", b"\0\1", True) + element(2, 0x2, "UI", "1.2.840.10008.5.1.4.1.1.2", True) +
+                 element(2, 0x3, "UI", uid + ".%d" % z, True) + element(2, 0x10, "UI", syntax, True))
+    meta = element(2, 0, "UL", struct.pack("<I", len(meta_body)), True) + meta_body
+    pixels = b"".join(struct.pack(order + "h", (i * 37 + z * 11) % 2000 - 1000) for i in range(rows * columns))
+    if encapsulated:  # a basic offset table and one fragment: not a real codestream
+        pixel_data = (struct.pack("<HHHHI", 0x7FE0, 0x10, 0x424F, 0, 0xFFFFFFFF) + struct.pack("<HHI", 0xFFFE, 0xE000, 0) +
+                      struct.pack("<HHI", 0xFFFE, 0xE000, 8) + b"\xff\x4f\xff\x51\0\0\xff\xd9" +
+                      struct.pack("<HHI", 0xFFFE, 0xE0DD, 0))
+    else:
+        pixel_data = element(0x7FE0, 0x10, "OW", pixels)
+    data = (element(8, 0x16, "UI", "1.2.840.10008.5.1.4.1.1.2") + element(8, 0x18, "UI", uid + ".%d" % z) +
+            element(8, 0x60, "CS", "CT") + element(0x20, 0xD, "UI", uid + ".7") + element(0x20, 0xE, "UI", uid + ".8") +
+            element(0x20, 0x13, "IS", str(z + 1)) + element(0x20, 0x32, "DS", "-10\\20\\%g" % (2.5 * z)) +
+            element(0x20, 0x37, "DS", "1\\0\\0\\0\\1\\0") + element(0x28, 0x2, "US", us(1)) +
+            element(0x28, 0x4, "CS", "MONOCHROME2") + element(0x28, 0x10, "US", us(rows)) +
+            element(0x28, 0x11, "US", us(columns)) + element(0x28, 0x30, "DS", "0.8\\0.8") +
+            element(0x28, 0x100, "US", us(16)) + element(0x28, 0x101, "US", us(16)) + element(0x28, 0x102, "US", us(15)) +
+            element(0x28, 0x103, "US", us(1)) + element(0x28, 0x1052, "DS", "0") + element(0x28, 0x1053, "DS", "1") +
+            pixel_data)
+    return (b"\0" * 128 + b"DICM" + meta if preamble else b"") + data
+
+
+def dicom_seeds():
+    variants = {
+        "implicit_le": {},
+        "explicit_le": {"syntax": "1.2.840.10008.1.2.1"},
+        "explicit_be": {"syntax": "1.2.840.10008.1.2.2"},
+        "no_preamble": {"preamble": False},
+        "jpeg2000_fragment": {"syntax": "1.2.840.10008.1.2.4.90", "encapsulated": True},
+    }
+    for name, options in variants.items():
+        first, second = dicom_slice(0, **options), dicom_slice(1, **options)
+        write("fuzz_dicom", name, struct.pack("<H", len(first)) + first + second)
+
+
+# ---- MetaImage and NRRD (fuzz_image_header: first byte even .mha, odd .nrrd) ---------------------
+
+
+def image_header_seeds():
+    n = 4
+    ramp = b"".join(struct.pack("<h", (i * 37) % 2000 - 1000) for i in range(n ** 3))
+    mha = ("ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n{}"
+           "TransformMatrix = 1 0 0 0 1 0 0 0 1\nOffset = -10 20 30\nDimSize = 4 4 4\n"
+           "ElementSpacing = 0.8 0.8 1.25\nElementType = MET_SHORT\nElementDataFile = LOCAL\n")
+    write("fuzz_image_header", "raw.mha", b"\0" + mha.format("").encode() + ramp)
+    write("fuzz_image_header", "zlib.mha", b"\0" + mha.format("CompressedData = True\n").encode() + __import__("zlib").compress(ramp))
+    nrrd = ("NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 4 4\n"
+            "space directions: (0.8,0,0) (0,0.8,0) (0,0,1.25)\nspace origin: (-10,20,30)\nendian: little\n"
+            "encoding: {}\n\n")
+    write("fuzz_image_header", "raw.nrrd", b"\1" + nrrd.format("raw").encode() + ramp)
+    write("fuzz_image_header", "gzip.nrrd", b"\1" + nrrd.format("gzip").encode() + gzip.compress(ramp, mtime=0))
+
+
 def scene_seeds():
     scenes = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes")
     for name in sorted(os.listdir(scenes)):
@@ -300,6 +378,8 @@ def main():
     pairs_seeds()
     manifest_seeds()
     nifti_seeds()
+    dicom_seeds()
+    image_header_seeds()
     scene_seeds()
 
 

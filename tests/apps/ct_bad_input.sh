@@ -85,6 +85,9 @@ expect 3 "missing slice?); the folder holds 1 file(s) that could not be read as 
 rm -rf "$T/s" && mkdir "$T/s" && cp "$T/p/dicom/slice_003"[012].dcm "$T/s/"
 expect 3 "expected a 3-D volume of at least 4 voxels along each axis in $T/s, found size 95x75x3" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
+# A bare data set (no preamble) that GDCM would take for DICOM and abort on: refused by name.
+slices && printf '\x02\x00\x00\x00\x72\x00\x00\x00\x02\x00' > "$T/s/bare.dcm"
+expect 3 "bare.dcm: no DICOM preamble, and " -- "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
 test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for slices that disagree"; fail=1; }
 # Two CT series in one folder: listed, --series-uid needed.
 "$B/articula" phantom -o "$T/q" --seed 3 --spacing 1.5,1.5,2 -q
@@ -146,12 +149,21 @@ raw = struct.pack(f"<{n ** 3}h", *ball)
 open(f"{folder}/whole.mha", "wb").write(header("MET_SHORT") + raw)
 open(f"{folder}/cut.mha", "wb").write(header("MET_SHORT") + raw[: len(raw) // 2])
 packed = zlib.compress(raw)
-open(f"{folder}/cut-zlib.mha", "wb").write(header("MET_SHORT", "CompressedData = True\n") + packed[: len(packed) // 2])
+open(f"{folder}/cut-zlib.mha", "wb").write(
+    header("MET_SHORT", f"CompressedData = True\nCompressedDataSize = {len(packed)}\n") + packed[: len(packed) // 2])
 values = [float(v) for v in ball]
 values[n ** 3 // 2] = float("nan")
 open(f"{folder}/nan.mha", "wb").write(header("MET_FLOAT") + struct.pack(f"<{n ** 3}f", *values))
 open(f"{folder}/flat.mha", "wb").write(header("MET_SHORT") + struct.pack(f"<{n ** 3}h", *([-1000] * n ** 3)))
+# ITK's MetaIO keeps zeros without CompressedDataSize, and spun for ever on a negative NDims given twice.
+open(f"{folder}/unsized-zlib.mha", "wb").write(header("MET_SHORT", "CompressedData = True\n") + packed)
+open(f"{folder}/ndims.mha", "wb").write(header("MET_SHORT").replace(b"NDims = 3", b"NDims = 2"))
+open(f"{folder}/twice.mha", "wb").write(header("MET_SHORT", "NDims = -10 20 30\n") + raw)
 PY
+expect 3 "CompressedData = True without CompressedDataSize: .*expected the line CompressedDataSize = $(( $(stat -c %s "$T/unsized-zlib.mha") - $(grep -abo 'LOCAL' "$T/unsized-zlib.mha" | cut -d: -f1) - 6 ))" -- \
+  "$B/articula-segment" -i "$T/unsized-zlib.mha" -o "$T/l.nii.gz"
+expect 3 "NDims = 2; expected NDims = 3" -- "$B/articula-segment" -i "$T/ndims.mha" -o "$T/l.nii.gz"
+expect 3 "gives 'NDims' twice" -- timeout 60 "$B/articula-segment" -i "$T/twice.mha" -o "$T/l.nii.gz"
 expect 3 "announces 27648 bytes of voxel data, the file holds 13824: the file is cut short" -- \
   "$B/articula-segment" -i "$T/cut.mha" -o "$T/l.nii.gz"
 expect 3 "compressed voxel data is damaged\|the file is cut short" -- "$B/articula-segment" -i "$T/cut-zlib.mha" -o "$T/l.nii.gz"

@@ -205,28 +205,6 @@ class Walker {
   void seek(std::uint64_t to) { pos_ = to; }
 };
 
-// A data set with no preamble (as old writers and some archives store
-// them), which GDCM still reads: walked from its first byte, in implicit or
-// explicit VR little endian as its first element shows, for its slice header.
-// Anything else is no DICOM file this check knows.
-void walkWithoutPreamble(std::ifstream& in, std::uint64_t size, DicomSliceHeader& header) {
-  unsigned char first[6] = {};
-  if (size < 8 || !in.seekg(0) || !in.read(reinterpret_cast<char*>(first), 6)) return;
-  const unsigned group = first[0] | unsigned(first[1]) << 8;
-  if (group != 0x0002 && group != 0x0008) return;
-  DicomSliceHeader found;
-  try {
-    Walker walk(in, size);
-    walk.header = &found;
-    walk.explicit_vr = std::isupper(first[4]) && std::isupper(first[5]);
-    while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
-  } catch (const Broken&) {
-    return;
-  }
-  found.read = true;
-  header = found;
-}
-
 }  // namespace
 
 DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
@@ -240,15 +218,20 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
     return result;
   }
   char magic[4] = {};
-  if (size < 132 || !in.seekg(128) || !in.read(magic, 4) || std::string(magic, 4) != "DICM") {
-    in.clear();
-    walkWithoutPreamble(in, size, result.header);
-    return result;  // NotDicom
-  }
+  const bool preamble = size >= 132 && in.seekg(128) && in.read(magic, 4) && std::string(magic, 4) == "DICM";
+  in.clear();
+  // Without a preamble (as old writers and some archives store data sets),
+  // GDCM reads a file whose first group is 0x0002 or 0x0008 (0x0800
+  // byte-swapped, ACR-NEMA) as DICOM, and aborts the process on some it
+  // cannot parse: such files are walked too. Any other is no DICOM file.
+  unsigned char first[6] = {};
+  if (!preamble && (size < 6 || !in.seekg(0) || !in.read(reinterpret_cast<char*>(first), 6))) return result;
+  const unsigned first_group = first[0] | unsigned(first[1]) << 8;
+  if (!preamble && first_group != 0x0002 && first_group != 0x0008 && first_group != 0x0800) return result;
   try {
     Walker walk(in, size);
     walk.header = &result.header;
-    walk.seek(132);
+    walk.seek(preamble ? 132 : 0);
     // The meta header (group 0002) is explicit VR little endian; its transfer
     // syntax says how the data set after it is encoded.
     std::string syntax;
@@ -258,21 +241,26 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
       if (walk.element(0, &value) == 0x00020010u) syntax = value;
       any_meta = true;
     }
-    if (!any_meta) throw Broken("no meta header after the DICM preamble");
+    if (preamble && !any_meta) throw Broken("no meta header after the DICM preamble");
     while (!syntax.empty() && (syntax.back() == '\0' || syntax.back() == ' ')) syntax.pop_back();
     if (syntax == "1.2.840.10008.1.2.1.99") {  // deflated: the data set is a zlib stream, not walked
       result.kind = DicomFileKind::Complete;
       return result;  // header.read stays false: the series check refuses it by name
     }
-    walk.explicit_vr = syntax != "1.2.840.10008.1.2";
-    walk.big_endian = syntax == "1.2.840.10008.1.2.2";
+    if (any_meta) {
+      walk.explicit_vr = syntax != "1.2.840.10008.1.2";
+      walk.big_endian = syntax == "1.2.840.10008.1.2.2";
+    } else {  // a bare data set: its first element shows how it is encoded
+      walk.big_endian = first_group == 0x0800;
+      walk.explicit_vr = !walk.big_endian && std::isupper(first[4]) && std::isupper(first[5]);
+    }
     // Zero bytes after the last element are padding some writers leave; GDCM stops there too.
     while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
     result.kind = DicomFileKind::Complete;
-    result.header.read = syntax != "1.2.840.10008.1.2.1.99";
+    result.header.read = true;
   } catch (const Broken& e) {
     result.kind = DicomFileKind::Damaged;
-    result.problem = e.what();
+    result.problem = (preamble ? "" : "no DICOM preamble, and ") + std::string(e.what());
   }
   return result;
 }

@@ -16,8 +16,8 @@ namespace articula::imaging {
 
 enum class DicomFileKind {
   Complete,     // every element ends within the file
-  Damaged,      // looks like DICOM (a "DICM" preamble) but an element runs past the end, or the structure is broken
-  NotDicom,     // no preamble: left to GDCM, which skips what it cannot read
+  Damaged,      // looks like DICOM (a "DICM" preamble, or a data set's first group) but an element runs past the end, or the structure is broken
+  NotDicom,     // neither: left to GDCM, which skips what it cannot read
 };
 
 /// What a slice's top-level data set says about its place and its pixels,

@@ -34,9 +34,10 @@ std::string trimmed(const std::string& s) {
 }
 
 /// The bytes a zlib or gzip stream inflates to, read from `in` (to its end,
-/// or to where the stream ends); -1 when it is damaged. Counted in chunks:
+/// to `limit` bytes when that is not negative, or to where the stream ends);
+/// -1 when it is damaged. Counted in chunks:
 /// nothing of the image is kept.
-long long inflatedLength(std::istream& in) {
+long long inflatedLength(std::istream& in, long long limit) {
   z_stream z{};
   if (inflateInit2(&z, 15 + 32) != Z_OK) return -1;  // 15 + 32: zlib or gzip, by its header
   std::vector<unsigned char> input(1 << 16), output(1 << 16);
@@ -44,7 +45,10 @@ long long inflatedLength(std::istream& in) {
   int rc = Z_OK;
   while (rc != Z_STREAM_END) {
     if (z.avail_in == 0) {
-      in.read(reinterpret_cast<char*>(input.data()), static_cast<std::streamsize>(input.size()));
+      long long want = static_cast<long long>(input.size());
+      if (limit >= 0) want = std::min(want, limit);
+      in.read(reinterpret_cast<char*>(input.data()), static_cast<std::streamsize>(want));
+      if (limit >= 0) limit -= in.gcount();
       z.avail_in = static_cast<uInt>(in.gcount());
       z.next_in = input.data();
       if (z.avail_in == 0) break;  // the stream ends early
@@ -66,6 +70,7 @@ struct DataLayout {
   fs::path file;
   std::streamoff offset = 0;
   bool compressed = false;
+  long long compressed_size = -1;  // the header's word on it, when it says
 };
 
 void checkLength(const fs::path& header_file, const DataLayout& data) {
@@ -74,7 +79,7 @@ void checkLength(const fs::path& header_file, const DataLayout& data) {
   long long found = 0;
   if (data.compressed) {
     in.seekg(data.offset);
-    found = inflatedLength(in);
+    found = inflatedLength(in, data.compressed_size);
     if (found < 0) throw InputError(header_file.string() + ": its compressed voxel data is damaged");
   } else {
     in.seekg(0, std::ios::end);
@@ -122,9 +127,20 @@ void checkMetaImage(const fs::path& path) {
     const auto eq = line.find('=');
     if (eq == std::string::npos) continue;
     const std::string key = trimmed(line.substr(0, eq));
-    fields[key] = trimmed(line.substr(eq + 1));
+    // MetaIO reads the fields in order, each sized by the NDims it has read
+    // so far: a second NDims, or a second of any field, would make it read
+    // other numbers than those judged here.
+    if (!fields.emplace(key, trimmed(line.substr(eq + 1))).second)
+      throw InputError(path.string() + ": the MetaImage header gives '" + excerpt(key) +
+                       "' twice; expected each field once");
     if (key == "ElementDataFile") break;
   }
+  // ITK's MetaIO reads NDims numbers for each of the sizes, spacings and
+  // offsets, and NDims^2 for the matrix, trusting NDims: a negative one
+  // spun it for ever. Only a 3-D volume is of use here.
+  if (fields.count("NDims") && fields["NDims"] != "3")
+    throw InputError(path.string() + ": the MetaImage header says NDims = " + excerpt(fields["NDims"]) +
+                     "; expected NDims = 3 (a 3-D volume)");
   if (!fields.count("ElementDataFile") || !fields.count("DimSize") || !fields.count("ElementType")) return;
   const auto type = kBytes.find(fields["ElementType"]);
   const std::vector<unsigned long long> sizes = sizesOf(fields["DimSize"]);
@@ -145,6 +161,22 @@ void checkMetaImage(const fs::path& path) {
     data.file = fs::path(where).is_absolute() ? fs::path(where) : path.parent_path() / where;
   } else {
     return;  // a list or pattern of slice files: ITK reads and checks them
+  }
+  if (data.compressed) {
+    // ITK's MetaImage reader inflates exactly CompressedDataSize bytes: without
+    // the field it fails and keeps zeros in the image, saying only
+    // "Uncompress failed" on the terminal.
+    const std::vector<unsigned long long> given = sizesOf(fields["CompressedDataSize"]);
+    if (given.size() != 1) {
+      std::error_code ec;
+      const auto file_size = static_cast<long long>(fs::file_size(data.file, ec));
+      const long long stored = ec ? -1 : file_size - (where == "LOCAL" ? static_cast<long long>(data.offset) : 0);
+      throw InputError(path.string() + ": CompressedData = True without CompressedDataSize: ITK's reader cannot "
+                       "inflate the voxels without it (it reads zeros); expected the line CompressedDataSize = " +
+                       (stored >= 0 ? std::to_string(stored) : std::string("<bytes of compressed data>")) +
+                       " before ElementDataFile");
+    }
+    data.compressed_size = static_cast<long long>(std::min(given[0], 1ULL << 62));
   }
   checkLength(path, data);
 }
