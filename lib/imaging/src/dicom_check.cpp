@@ -71,9 +71,12 @@ class Walker {
       vr = bytes(2);
       if (!(vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z'))
         throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has no value representation");
-      static const char* kLong[] = {"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "UC", "UR", "UT", "UN", "SV", "UV"};
-      bool long_form = false;
-      for (const char* l : kLong) long_form = long_form || vr == l;
+      // PS3.5 7.1.2: the VRs with a 2-byte length; any other, an unknown one
+      // included, has 2 reserved bytes and a 4-byte length (as GDCM reads it).
+      static const char* kShort[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FL", "FD", "IS", "LO",
+                                     "LT", "PN", "SH", "SL", "SS", "ST", "TM", "UI", "UL", "US"};
+      bool long_form = true;
+      for (const char* l : kShort) long_form = long_form && vr != l;
       if (long_form) {
         skip(2, tag, start);
         length = read32();
