@@ -108,6 +108,8 @@ class SegmentCommand : public cli::Command {
         {"hu_window", {options_.hu_min, options_.hu_max}},
         {"seed_source", s.seed_source},
         {"side_check", s.side_check},
+        {"body_middle_x_mm", s.body_middle_x_mm ? nlohmann::json(*s.body_middle_x_mm) : nlohmann::json(nullptr)},
+        {"body_middle_from", s.body_middle_from},
         {"seed_mm", vec(s.seed_mm)},
         {"head_center_mm", vec(s.head_center_mm)},
         {"search_radius_mm", s.search_radius_mm},

@@ -3,7 +3,9 @@
 // blob, a cut cap, a non-spherical patch, a search that found elsewhere,
 // a side the search could not tell, points inside the bone, a shell label
 // off the CT's edges at coarse voxels, a socket's outer surface that faces
-// no socket); a cortex blurred away across the slices warns.
+// no socket, a head on the body's midline); a cortex blurred away across
+// the slices warns, and so does a head at the other joint's distance from
+// the body's middle.
 #include <cmath>
 #include <functional>
 
@@ -100,6 +102,31 @@ TEST(HeadQc, AnUnverifiedSideWarns) {
   EXPECT_EQ(r.status, "warn");
   EXPECT_EQ(check(r, "side_verified").status, "warn");
   EXPECT_NE(check(r, "side_verified").reason.find("side could not be verified"), std::string::npos);
+}
+
+TEST(HeadQc, AHeadAtTheOtherJointsDistanceFromTheMiddleWarnsAndOneOnTheMidlineFails) {
+  // The cap's centre lies at x = -90 mm.
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.joint = "hip";
+  in.body_middle_x_mm = 0;
+  EXPECT_EQ(check(pipeline::checkHead(in), "head_from_body_middle_mm").status, "pass");
+  EXPECT_DOUBLE_EQ(check(pipeline::checkHead(in), "head_from_body_middle_mm").value, 90);
+  in.joint = "shoulder";  // a shoulder run on a hip CT
+  pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "head_from_body_middle_mm").status, "warn");
+  EXPECT_NE(check(r, "head_from_body_middle_mm").reason.find("is this a hip CT?"), std::string::npos);
+  in.body_middle_x_mm = 45;  // 135 mm from the middle: a humeral head's place
+  EXPECT_EQ(check(pipeline::checkHead(in), "head_from_body_middle_mm").status, "pass");
+  in.joint = "hip";
+  r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "head_from_body_middle_mm").status, "warn");
+  EXPECT_NE(check(r, "head_from_body_middle_mm").reason.find("is this a shoulder CT?"), std::string::npos);
+  in.body_middle_x_mm = -80;  // 10 mm: a vertebra or the symphysis
+  r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "head_from_body_middle_mm").status, "fail");
+  EXPECT_EQ(r.status, "fail");
+  in.body_middle_x_mm.reset();  // no middle measured: no check
+  EXPECT_THROW(check(pipeline::checkHead(in), "head_from_body_middle_mm"), std::runtime_error);
 }
 
 TEST(HeadQc, TwoDoubtsTogetherFail) {

@@ -449,6 +449,8 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
     const std::optional<Side> by_socket = sideBySocket(volume, c, options);
     return by_socket && *by_socket == options.side;
   };
+  if (side_by_position) side.middle_x_mm = mid_x;
+  side.middle_from_outline = body_mid.has_value();
   side.how = body_mid ? "left or right of the body's middle (x = " + std::to_string(*body_mid) + " mm, from its outline)"
                : wide   ? "left or right of the field of view's middle"
                         : "";

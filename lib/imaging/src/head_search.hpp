@@ -67,6 +67,8 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
 struct SideCheck {
   std::string how;           // empty: the side could not be verified
   bool other_side = false;   // the joint found is of the other side: refused
+  std::optional<double> middle_x_mm;  // the body's middle (LPS x) the side was judged by, when one was
+  bool middle_from_outline = false;   // from the body's outline (else the middle of a wide field of view)
 };
 bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side);
 /// The side a joint is on from its socket, medial to it across the joint

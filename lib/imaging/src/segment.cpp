@@ -279,6 +279,8 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
       throw ProcessingError(m.str());
     }
     summary.side_check = side_check.how.empty() ? "not verified" : side_check.how;
+    summary.body_middle_x_mm = side_check.middle_x_mm;
+    if (side_check.middle_x_mm) summary.body_middle_from = side_check.middle_from_outline ? "outline" : "field of view";
     if (side_check.how.empty())
       summary.warnings.push_back("the " + side + " side could not be verified: the field of view shows neither the body's "
                                  "outline on both sides nor a socket clearly medial to the head; the joint in view was taken");

@@ -41,6 +41,7 @@ constexpr double kShellDepthRelative = 0.4;
 constexpr double kSocketFacingWarn = 0.15, kSocketFacingFail = 0.08;
 constexpr double kSocketRiseHu = 100;
 constexpr double kSocketFromMm = 0.5, kSocketToMm = 8.0, kSocketStepMm = 0.25;
+constexpr double kMidlineFailMm = 30, kHipFromMiddleWarnMm = 125, kShoulderFromMiddleWarnMm = 100;
 constexpr int kDoubtsThatFail = 2;                              // warnings of the structure's checks
 
 std::string number(double v) {
@@ -246,6 +247,32 @@ QcReport checkHead(const HeadQcInput& in) {
       contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the "
                          "blur across the slices";
     report.checks.push_back(contrast);
+  }
+  if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
+    // Femoral heads lie 60-110 mm from the body's middle (half the distance
+    // between them), humeral heads 120-190 mm (the glenoids on either side
+    // of the thorax): a head at the other joint's distance is likely the
+    // other joint (a shoulder run on a hip CT), one on the midline a vertebra
+    // or the symphysis.
+    const bool hip = in.joint == "hip";
+    QcCheck lateral;
+    lateral.name = "head_from_body_middle_mm";
+    lateral.value = std::abs(c.x() - *in.body_middle_x_mm);
+    lateral.rule = std::string("fail below ") + number(kMidlineFailMm) + " mm; warn " +
+                   (hip ? "above " + number(kHipFromMiddleWarnMm) : "below " + number(kShoulderFromMiddleWarnMm)) + " mm";
+    lateral.status = "pass";
+    if (lateral.value < kMidlineFailMm) {
+      lateral.status = "fail";
+      lateral.reason = "the head lies " + number(lateral.value) +
+                       " mm from the body's middle: a structure on the midline (a vertebra, the symphysis), not a joint head";
+    } else if (hip ? lateral.value > kHipFromMiddleWarnMm : lateral.value < kShoulderFromMiddleWarnMm) {
+      lateral.status = "warn";
+      lateral.reason = "the head lies " + number(lateral.value) + " mm from the body's middle, " +
+                       (hip ? "where humeral heads lie (femoral heads: 60-110 mm): is this a shoulder CT?"
+                            : "where femoral heads lie (humeral heads: 120-190 mm): is this a hip CT?") +
+                       " Check --joint";
+    }
+    report.checks.push_back(lateral);
   }
   if (in.side_verified) {
     QcCheck side;

@@ -105,6 +105,7 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
   if (sphere == shapes.end()) throw InputError("fits.json holds no sphere: the head checks need one (fit --models with sphere)");
   in.sphere_center = sphere->center;
   in.sphere_radius_mm = sphere->radii[0];
+  in.joint = joint;
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);
@@ -115,6 +116,8 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
         in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());
         in.search_radius_mm = seg.value("search_radius_mm", 0.0);
         if (seg.contains("side_check")) in.side_verified = seg.value("side_check", "") != "not verified";
+        if (seg.contains("body_middle_x_mm") && seg.at("body_middle_x_mm").is_number())
+          in.body_middle_x_mm = seg.at("body_middle_x_mm").get<double>();
       }
     } catch (const json::exception& e) {
       throw InputError("cannot read the segmentation summary '" + segment_summary.string() + "': " + e.what());

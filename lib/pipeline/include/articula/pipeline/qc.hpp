@@ -46,6 +46,8 @@ struct HeadQcInput {
   std::optional<double> label_depth_mm;          // the segmentation's label: the depth of its deepest voxel
   std::optional<double> socket_facing_share;     // socketFacingShare, for a hip where measurable
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
+  std::string joint;                             // "hip" or "shoulder", for the head's distance from the body's middle
+  std::optional<double> body_middle_x_mm;        // the search's body middle (LPS x), if it judged the side by one
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
 };
 
