@@ -87,6 +87,9 @@ class BatchCommand : public cli::Command {
     OutputLock lock(study_dir_, "articula batch");
     try {
       if (!common.force) refuseTablesNotOurs();
+      if (!common.force && !gather_only_)
+        cli::refuseToOverwrite(pipeline::subjectFilesNotOurs(subjects, study_dir_),
+                               ", which articula batch did not write (use --force, or another --output)");
     } catch (...) {
       lock.removeIfUnused();
       throw;

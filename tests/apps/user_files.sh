@@ -103,6 +103,29 @@ expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q --force
 grep -q '"provenance"' "$c/label.nii.gz.json" || fail "run --force did not replace the sidecar"
 expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q
 
+# The stage programs check what they write beside their output the same way.
+echo '{"mine": true}' > "$tmp/label.nii.gz.json"
+expect_rc 2 "$bin/articula-segment" -i "$p/phantom.nii.gz" -o "$tmp/label.nii.gz" -q
+grep -q "refusing to overwrite .*label.nii.gz.json (use --force)" "$tmp/err" || fail "segment: $(cat "$tmp/err")"
+[ ! -e "$tmp/label.nii.gz" ] || fail "segment wrote before refusing"
+expect_rc 0 "$bin/articula-segment" -i "$p/phantom.nii.gz" -o "$tmp/label.nii.gz" -q --force
+grep -q '"provenance"' "$tmp/label.nii.gz.json" || fail "segment --force did not replace its sidecar"
+cp -r "$c" "$tmp/rep" && rm -r "$tmp/rep/results.json" "$tmp/rep/slicer"
+expect_rc 2 "$bin/articula-report" -i "$tmp/rep" --ct "$p/phantom.nii.gz" -q
+grep -q "refusing to overwrite .*report.html, .*results.csv, .*scene.mrml (use --force)" "$tmp/err" ||
+  fail "report: $(cat "$tmp/err")"
+[ ! -e "$tmp/rep/results.json" ] || fail "report wrote before refusing"
+
+# batch: a status.json of the user's in a subject's folder is refused by name.
+mkdir -p "$tmp/bs/subjects/s1"
+echo '{"mine": true}' > "$tmp/bs/subjects/s1/status.json"
+expect_rc 2 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/bs" -q
+grep -q "refusing to overwrite .*subjects/s1/status.json, which articula batch did not write" "$tmp/err" ||
+  fail "batch: status.json not named: $(cat "$tmp/err")"
+[ "$(cat "$tmp/bs/subjects/s1/status.json")" = '{"mine": true}' ] || fail "batch replaced the user's status.json"
+expect_rc 0 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/bs" -q --force
+grep -q '"command"' "$tmp/bs/subjects/s1/status.json" || fail "batch --force did not replace status.json"
+
 # One run per output folder: a second run on the folder of a running one is
 # refused at once (exit 1) naming the folder and the first's pid, and the
 # first completes. The first is paused once it holds the lock, so that it

@@ -199,6 +199,14 @@ void refuseToOverwrite(const std::vector<std::string>& existing, const std::stri
   throw UsageError("refusing to overwrite " + list + advice);
 }
 
+void refuseExistingOutputs(const std::vector<std::filesystem::path>& files, bool force) {
+  if (force) return;
+  std::vector<std::string> existing;
+  for (const auto& file : files)
+    if (std::filesystem::exists(file)) existing.push_back(file.string());
+  refuseToOverwrite(existing, " (use --force)");
+}
+
 std::string argumentProblem(const std::string& name, const std::vector<std::string>& args) {
   auto command = createCommand(name);
   CLI::App app;
