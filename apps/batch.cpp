@@ -14,6 +14,7 @@
 #include "articula/core/excerpt.hpp"
 #include "articula/core/json_file.hpp"
 #include "articula/core/log.hpp"
+#include "articula/core/output_lock.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/pipeline/batch.hpp"
 #include "articula/pipeline/manifest.hpp"
@@ -80,8 +81,19 @@ class BatchCommand : public cli::Command {
     options.quiet = common.verbosity == 0;
     options.rerun_finished = common.force;
     if (gather_only_) options.jobs = 1;
-    if (!common.force) refuseTablesNotOurs();
-    fs::create_directories(study_dir_);
+    if (fs::exists(study_dir_) && !fs::is_directory(study_dir_))
+      throw UsageError("output '" + study_dir_.string() + "' is a file: expected the study folder");
+    // One batch per study folder at a time (each subject's run locks its own).
+    OutputLock lock(study_dir_, "articula batch");
+    try {
+      if (!common.force) refuseTablesNotOurs();
+      if (!common.force && !gather_only_)
+        cli::refuseToOverwrite(pipeline::subjectFilesNotOurs(subjects, study_dir_),
+                               ", which articula batch did not write (use --force, or another --output)");
+    } catch (...) {
+      lock.removeIfUnused();
+      throw;
+    }
     pipeline::BatchSummary summary;
     if (gather_only_) {
       summary = pipeline::gatherOutcomes(subjects, study_dir_);
@@ -105,8 +117,6 @@ class BatchCommand : public cli::Command {
   // Refuses, before any subject runs, study tables in the study folder that
   // no earlier batch wrote (its study.json, written first, says which did).
   void refuseTablesNotOurs() const {
-    if (fs::exists(study_dir_) && !fs::is_directory(study_dir_))
-      throw UsageError("output '" + study_dir_.string() + "' is a file: expected the study folder");
     const std::optional<nlohmann::json> earlier = readJsonFileIfValid(study_dir_ / "study.json");
     const bool ours = earlier && earlier->contains("provenance") && earlier->contains("subjects");
     if (ours) return;

@@ -137,6 +137,7 @@ class ContactCommand : public cli::Command {
     options_.validate();
     if (pairs_.empty() && scenario_.empty() && fits_a_.empty())
       throw UsageError("expected one of --pairs, --scenario or --fits-a/--fits-b");
+    cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
     if (!pairs_.empty()) return runPairs(common);
     if (!scenario_.empty()) return runScenario(common);
     return runFits(common);

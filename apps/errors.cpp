@@ -106,6 +106,7 @@ class ErrorsCommand : public cli::Command {
     for (const auto& shape : shapes)
       for (const char* kind : {"points_", "surface_"})
         outputs.push_back(output_ / (kind + geometry::modelName(shape.model) + ".ply"));
+    for (const auto& shape : shapes) outputs.push_back(output_ / ("points_" + geometry::modelName(shape.model) + ".vtp"));
     refuseOutputsOverInputs(outputs, {input_, fits_});
     // An interrupted run of this stage left its marker (removed once
     // summary.json, written last, is in place): its files are redone

@@ -116,9 +116,7 @@ class FitCommand : public cli::Command {
     const std::filesystem::path csv = std::filesystem::path(output_).replace_extension(".csv");
     refuseOutputsOverInputs({output_, csv}, {input_, bounds_file_});
     checkOutputTarget(output_);
-    for (const auto& path : {output_, csv})
-      if (std::filesystem::exists(path) && !common.force)
-        throw UsageError("output '" + path.string() + "' exists (use --force to overwrite)");
+    cli::refuseExistingOutputs({output_, csv}, common.force);
 
     const points::PointCloud cloud = points::readPoints(input_);
     points::checkFittable(cloud, geometry::parameterCount(ShapeModel::Superovoid), input_.string());

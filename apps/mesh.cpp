@@ -65,8 +65,7 @@ class MeshCommand : public cli::Command {
     const std::string ext = output_.extension().string();
     if (ext != ".vtp" && ext != ".stl" && ext != ".ply")
       throw UsageError("--output: expected a .vtp, .stl or .ply file, found '" + output_.string() + "'");
-    if (!common.force && std::filesystem::exists(output_))
-      throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
+    cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
     snap_.edge_model = edge_model_ == "cortex"     ? mesh::EdgeModel::Cortex
                        : edge_model_ == "steepest" ? mesh::EdgeModel::SteepestFall
                                                    : mesh::EdgeModel::Automatic;

@@ -5,6 +5,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/pipeline/stages.hpp"
 #include "articula/pipeline/subject_report.hpp"
 
 namespace articula::apps {
@@ -41,8 +42,11 @@ class ReportCommand : public cli::Command {
   int run(const cli::CommonOptions& common) override {
     if (!std::filesystem::is_directory(options_.folder))
       throw InputError("--input: expected a subject folder, found '" + options_.folder.string() + "'");
-    if (!common.force && std::filesystem::exists(options_.folder / "results.json"))
-      throw UsageError("refusing to overwrite " + (options_.folder / "results.json").string() + " (use --force)");
+    // Every file the stage writes (the stage table's outputs and sidecars).
+    std::vector<std::filesystem::path> existing;
+    for (const std::string& file : pipeline::stageFilesIn(pipeline::stageNamed(name()), options_.folder))
+      existing.push_back(options_.folder / file);
+    cli::refuseExistingOutputs(existing, common.force);
     options_.seed = common.seed;
     const pipeline::QcReport qc = pipeline::writeSubjectReport(options_);
     for (const std::string& reason : qc.reasons()) log::warn("qc " + reason);

@@ -20,6 +20,7 @@
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/number_text.hpp"
+#include "articula/core/output_lock.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/core/version.hpp"
@@ -101,43 +102,19 @@ class RunCommand : public cli::Command {
                        "expected a DICOM folder or a CT image file");
     if (fs::exists(output_) && !fs::is_directory(output_))
       throw UsageError("output '" + output_.string() + "' is a file: expected a folder for the stages' outputs");
-    refuseOutputsNotOurs(first, last, common);
-    fs::create_directories(output_ / ".articula");
-    const imaging::VolumeMemory read_once;
-    // The folders a run writes in: the subject's, its errors and its stamps.
-    int stale = 0;
-    for (const fs::path& folder : {output_, output_ / "errors", output_ / ".articula"})
-      stale += removeStaleTemporaries(folder);
-    if (stale > 0)
-      log::info("removed " + std::to_string(stale) + " unfinished file(s) of an interrupted earlier run");
-    for (int i = first; i <= last; ++i) {
-      const pipeline::StageDescription& stage = table[static_cast<size_t>(i)];
-      const Plan plan = stagePlan(stage, common);
-      for (const auto& in : plan.inputs)
-        if (!fs::exists(in))
-          throw InputError("stage " + stage.name + " needs '" + in.string() + "', which is missing: run the earlier stages first");
-      // Another build of articula reruns every stage: its outputs may differ.
-      json stamp = {{"articula", versionString()}, {"args", plan.args}, {"inputs", json::object()}};
-      for (const auto& in : plan.inputs) stamp["inputs"][in.string()] = hashInput(in);
-      const fs::path stamp_path = output_ / ".articula" / (stage.name + ".json");
-      const bool forced = common.force || (!from_.empty() && i == first);
-      if (!forced && upToDate(plan, stamp, stamp_path)) {
-        log::info("run: " + stage.name + " is up to date");
-        continue;
-      }
-      // A stamp naming the outputs before the stage writes them: they are
-      // run's own, to replace when the stage is redone, even if it is killed.
-      json started = {{"articula", versionString()}, {"status", "started"}, {"outputs", json::object()}};
-      for (const auto& out : plan.outputs) started["outputs"][out.string()] = "";
-      writeFileAtomically(stamp_path, started.dump(2) + "\n");
-      log::info("run: [" + std::to_string(i - first + 1) + "/" + std::to_string(last - first + 1) + "] " + stage.name + " ...");
-      const auto t0 = std::chrono::steady_clock::now();
-      const int rc = cli::runCommandInProcess(stage.name, plan.args);
-      if (rc != 0) return rc;  // the stage has said why on stderr
-      stamp["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      stamp["outputs"] = json::object();  // a damaged or replaced output reruns the stage
-      for (const auto& out : plan.outputs) stamp["outputs"][out.string()] = hashInput(out);
-      writeFileAtomically(stamp_path, stamp.dump(2) + "\n");
+    // One run per output folder at a time; a run that fails before any
+    // stage has written leaves no trace of itself there.
+    OutputLock lock(output_, "articula run");
+    int rc = 0;
+    try {
+      rc = runStages(first, last, common);
+    } catch (...) {
+      lock.removeIfUnused();
+      throw;
+    }
+    if (rc != 0) {
+      lock.removeIfUnused();
+      return rc;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     log::info("run: done in " + number(seconds) + " s: " + (output_ / "results.json").string());
@@ -185,8 +162,63 @@ class RunCommand : public cli::Command {
     return p;
   }
 
-  // Refuses, before any stage runs and unless --force, a stage output that
-  // exists but that no stamp of run names: a file run did not write.
+  // Runs stages first..last under the output folder's lock; a stage's exit
+  // code when it fails (it has said why on stderr).
+  int runStages(int first, int last, const cli::CommonOptions& common) const {
+    const auto& table = pipeline::stages();
+    refuseOutputsNotOurs(first, last, common);
+    const imaging::VolumeMemory read_once;
+    // The folders a run writes in: the subject's, its errors and its stamps.
+    int stale = 0;
+    for (const fs::path& folder : {output_, output_ / "errors", output_ / ".articula"})
+      stale += removeStaleTemporaries(folder);
+    if (stale > 0)
+      log::info("removed " + std::to_string(stale) + " unfinished file(s) of an interrupted earlier run");
+    for (int i = first; i <= last; ++i) {
+      const pipeline::StageDescription& stage = table[static_cast<size_t>(i)];
+      const Plan plan = stagePlan(stage, common);
+      for (const auto& in : plan.inputs)
+        if (!fs::exists(in))
+          throw InputError("stage " + stage.name + " needs '" + in.string() + "', which is missing: run the earlier stages first");
+      // Another build of articula reruns every stage: its outputs may differ.
+      json stamp = {{"articula", versionString()}, {"args", plan.args}, {"inputs", json::object()}};
+      for (const auto& in : plan.inputs) stamp["inputs"][in.string()] = hashInput(in);
+      const fs::path stamp_path = output_ / ".articula" / (stage.name + ".json");
+      const bool forced = common.force || (!from_.empty() && i == first);
+      if (!forced && upToDate(plan, stamp, stamp_path)) {
+        log::info("run: " + stage.name + " is up to date");
+        continue;
+      }
+      // A stamp naming the outputs (and the sidecars' patterns) before the
+      // stage writes them: they are run's own, to replace when the stage is
+      // redone, even if it is killed.
+      json started = {{"articula", versionString()}, {"status", "started"}, {"outputs", json::object()},
+                      {"sidecars", stage.sidecars}};
+      for (const auto& out : plan.outputs) started["outputs"][out.string()] = "";
+      writeFileAtomically(stamp_path, started.dump(2) + "\n");
+      log::info("run: [" + std::to_string(i - first + 1) + "/" + std::to_string(last - first + 1) + "] " + stage.name + " ...");
+      const auto t0 = std::chrono::steady_clock::now();
+      const int rc = cli::runCommandInProcess(stage.name, plan.args);
+      if (rc != 0) {
+        // Nothing of it written: its stamp would keep an empty folder.
+        if (pipeline::stageFilesIn(stage, output_).empty()) fs::remove(stamp_path);
+        return rc;
+      }
+      stamp["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      stamp["outputs"] = json::object();  // a damaged or replaced output reruns the stage
+      for (const auto& out : plan.outputs) stamp["outputs"][out.string()] = hashInput(out);
+      stamp["sidecars"] = json::array();
+      for (const auto& file : pipeline::stageFilesIn(stage, output_))
+        if (std::find(stage.outputs.begin(), stage.outputs.end(), file) == stage.outputs.end())
+          stamp["sidecars"].push_back(file);
+      writeFileAtomically(stamp_path, stamp.dump(2) + "\n");
+    }
+    return 0;
+  }
+
+  // Refuses, before any stage runs and unless --force, a stage's output or
+  // sidecar that exists but that no stamp of run names: a file run did not
+  // write.
   void refuseOutputsNotOurs(int first, int last, const cli::CommonOptions& common) const {
     if (common.force) return;
     std::vector<std::string> others;
@@ -194,17 +226,29 @@ class RunCommand : public cli::Command {
     for (int i = first; i <= last; ++i) {
       const pipeline::StageDescription& stage = table[static_cast<size_t>(i)];
       const std::optional<json> stamp = readJsonFileIfValid(output_ / ".articula" / (stage.name + ".json"));
-      for (const auto& out : stage.outputs) {
-        if (!fs::exists(output_ / out)) continue;
-        bool ours = false;
-        if (stamp && stamp->contains("outputs") && stamp->at("outputs").is_object())
-          for (const auto& [written, hash] : stamp->at("outputs").items())
-            ours = ours || written == out || (written.size() > out.size() &&
-                                              written.compare(written.size() - out.size() - 1, std::string::npos, "/" + out) == 0);
-        if (!ours) others.push_back((output_ / out).string());
-      }
+      for (const std::string& file : pipeline::stageFilesIn(stage, output_))
+        if (!stampNames(stamp, stage, file)) others.push_back((output_ / file).string());
     }
     cli::refuseToOverwrite(others, ", which articula run did not write (use --force, or another --output)");
+  }
+
+  // Whether a stage's stamp names `file` (relative to the output folder)
+  // among its outputs (keyed by path) or its sidecars (names or patterns).
+  static bool stampNames(const std::optional<json>& stamp, const pipeline::StageDescription& stage,
+                         const std::string& file) {
+    if (!stamp || !stamp->is_object()) return false;
+    if (stamp->contains("outputs") && stamp->at("outputs").is_object())
+      for (const auto& [written, hash] : stamp->at("outputs").items())
+        if (written == file || (written.size() > file.size() &&
+                                written.compare(written.size() - file.size() - 1, std::string::npos, "/" + file) == 0))
+          return true;
+    if (std::find(stage.outputs.begin(), stage.outputs.end(), file) != stage.outputs.end()) return false;
+    // Stamps of earlier versions listed no sidecars: those beside their outputs are theirs.
+    if (!stamp->contains("sidecars")) return true;
+    if (!stamp->at("sidecars").is_array()) return false;
+    for (const auto& entry : stamp->at("sidecars"))
+      if (entry.is_string() && pipeline::matchesFilePattern(entry.get<std::string>(), file)) return true;
+    return false;
   }
 
   static bool upToDate(const Plan& plan, const json& stamp, const fs::path& stamp_path) {

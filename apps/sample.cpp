@@ -50,8 +50,7 @@ class SampleCommand : public cli::Command {
     if (ext != ".ply" && ext != ".csv") throw UsageError("--output: expected a .ply or .csv file, found '" + output_.string() + "'");
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
     checkOutputTarget(output_);
-    if (!common.force && std::filesystem::exists(output_))
-      throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
+    cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
     const mesh::TriangleMesh m = mesh::readMesh(input_);
     const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options_);

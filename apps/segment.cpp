@@ -61,8 +61,7 @@ class SegmentCommand : public cli::Command {
     options_.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
     checkOutputTarget(output_);
-    if (!common.force && std::filesystem::exists(output_))
-      throw UsageError("refusing to overwrite " + output_.string() + " (use --force)");
+    cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
     imaging::ReadOptions read;
     read.series_uid = series_uid_;

@@ -66,6 +66,7 @@ class SurfaceCommand : public cli::Command {
     if (!center_.empty()) p.center = threeValues(center_, "--center", false);
     if (!angles_deg_.empty()) p.angles = threeValues(angles_deg_, "--angles-deg", false) * (M_PI / 180.0);
     if (output_.extension() != ".ply") throw UsageError("--output: expected a .ply file, found '" + output_.string() + "'");
+    cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
     const auto surface = geometry::makeSurface(p);
     const geometry::SurfaceMesh mesh = surface->sample(resolution_, resolution_ / 2);

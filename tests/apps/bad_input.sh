@@ -184,6 +184,12 @@ expect_rc 2 "$A" fit -i "$tmp/head.csv" -o "$tmp/t.json" --threads 100000
 [ ! -e "$tmp/t.json" ] || fail "fit ran with 100000 threads asked"
 expect_rc 2 "$A" fit -i "$tmp/head.csv" -o "$tmp/t.json" --sample-points 500
 grep -q "sample_points: expected 0 (all) or >= 1000" "$tmp/err" || fail "sample-points: $(cat "$tmp/err")"
+# A seed beyond its type's range: refused naming the range, not clamped.
+expect_rc 2 "$A" fit -i "$tmp/head.csv" -o "$tmp/t.json" --seed 99999999999999999999
+grep -q -- "--seed: expected a whole number in \[0, 9223372036854775807\], found '99999999999999999999'" "$tmp/err" ||
+  fail "seed out of range: $(cat "$tmp/err")"
+expect_rc 2 "$A" fit -i "$tmp/head.csv" -o "$tmp/t.json" --seed -1
+[ ! -e "$tmp/t.json" ] || fail "fit ran with a seed out of range"
 expect_rc 2 "$A" nosuch --help
 grep -q "unknown command 'nosuch'" "$tmp/err" || fail "nosuch --help: $(cat "$tmp/err")"
 # Manifest columns the batch sets itself, or that no stage has: refused by
@@ -204,6 +210,28 @@ refused_manifest typo 'subject,input,joint,side,smoothnes\ns1,4d.nii,hip,left,0.
   "typo.csv:2: subject s1: its options do not parse.*smoothnes" --validate
 refused_manifest bom '\xef\xbb\xbfid,input,joint,side\ns1,4d.nii,hip,left\n' "found 'id,input,joint,side'" --validate
 refused_manifest dots 'subject,input,joint,side\n..,4d.nii,hip,left\n' "not starting with '.'" --validate
+# Tables saved as UTF-16 ("Unicode text"), with its byte-order mark or
+# without (NUL bytes): refused at every CSV entry point, saying what to do;
+# a UTF-8 byte-order mark (Excel's "CSV UTF-8") is read as it is (in a
+# manifest: "bom" above).
+utf16="the file is UTF-16 (or has NUL bytes); save it as UTF-8 CSV"
+printf 'subject,input,joint,side\ns1,4d.nii,hip,left\n' | iconv -t UTF-16 > "$tmp/m16.csv"
+printf 'subject,input,joint,side\ns1,4d.nii,hip,left\n' | iconv -t UTF-16BE > "$tmp/m16be.csv"
+for m in m16 m16be; do
+  for validate in --validate ""; do
+    expect_rc 3 "$A" batch "$tmp/$m.csv" -o "$tmp/study-$m" $validate
+    grep -q "$m.csv:1: $utf16" "$tmp/err" || fail "batch -m $m.csv: $(cat "$tmp/err")"
+    [ ! -e "$tmp/study-$m" ] || fail "batch made a study folder for a UTF-16 manifest"
+  done
+done
+iconv -t UTF-16 "$ARTICULA_SOURCE/testdata/contact/pairs.csv" > "$tmp/pairs16.csv"
+expect_rc 3 "$A" contact --pairs "$tmp/pairs16.csv" -o "$tmp/pairs16_out.csv"
+grep -q "pairs16.csv:1: $utf16" "$tmp/err" || fail "contact --pairs UTF-16: $(cat "$tmp/err")"
+iconv -t UTF-16LE "$tmp/head.csv" > "$tmp/head16.csv"
+expect_rc 3 "$A" fit -i "$tmp/head16.csv" -o "$tmp/fits16.json"
+grep -q "head16.csv:1: $utf16" "$tmp/err" || fail "points UTF-16: $(cat "$tmp/err")"
+{ printf '\xef\xbb\xbf'; cat "$tmp/head.csv"; } > "$tmp/head-bom.csv"
+expect_rc 0 "$A" fit -i "$tmp/head-bom.csv" -o "$tmp/fits-bom.json" -q
 
 # A NIfTI cut short (half its voxels), plain and re-gzipped: refused, not zero-filled.
 nifti "$tmp/whole.nii" 16,16,16 1,1,1

@@ -89,4 +89,87 @@ for input in "$tmp/zero.nii" "$tmp/pipe.nii"; do
   expect_rc 3 timeout 60 "$bin/articula" run -i "$input" -o "$tmp/z" -q
   grep -q "neither a file nor a folder" "$tmp/err" || fail "run -i $input: $(cat "$tmp/err")"
 done
+# run: a sidecar of the user's (a stage's provenance .json, a per-model file
+# of the errors stage) is refused by name like an output; --force replaces it.
+c="$tmp/c"
+mkdir -p "$c/errors"
+echo '{"mine": true}' > "$c/label.nii.gz.json"
+echo "mine" > "$c/errors/points_sphere.vtp"
+expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q
+grep -q "refusing to overwrite .*label.nii.gz.json, .*errors/points_sphere.vtp, which articula run did not write" "$tmp/err" ||
+  fail "run: the user's sidecars not named: $(cat "$tmp/err")"
+[ "$(cat "$c/label.nii.gz.json")" = '{"mine": true}' ] && [ ! -e "$c/.articula" ] || fail "run wrote before refusing"
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q --force
+grep -q '"provenance"' "$c/label.nii.gz.json" || fail "run --force did not replace the sidecar"
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q
+
+# The stage programs check what they write beside their output the same way.
+echo '{"mine": true}' > "$tmp/label.nii.gz.json"
+expect_rc 2 "$bin/articula-segment" -i "$p/phantom.nii.gz" -o "$tmp/label.nii.gz" -q
+grep -q "refusing to overwrite .*label.nii.gz.json (use --force)" "$tmp/err" || fail "segment: $(cat "$tmp/err")"
+[ ! -e "$tmp/label.nii.gz" ] || fail "segment wrote before refusing"
+expect_rc 0 "$bin/articula-segment" -i "$p/phantom.nii.gz" -o "$tmp/label.nii.gz" -q --force
+grep -q '"provenance"' "$tmp/label.nii.gz.json" || fail "segment --force did not replace its sidecar"
+cp -r "$c" "$tmp/rep" && rm -r "$tmp/rep/results.json" "$tmp/rep/slicer"
+expect_rc 2 "$bin/articula-report" -i "$tmp/rep" --ct "$p/phantom.nii.gz" -q
+grep -q "refusing to overwrite .*report.html, .*results.csv, .*scene.mrml (use --force)" "$tmp/err" ||
+  fail "report: $(cat "$tmp/err")"
+[ ! -e "$tmp/rep/results.json" ] || fail "report wrote before refusing"
+
+# batch: a status.json of the user's in a subject's folder is refused by name.
+mkdir -p "$tmp/bs/subjects/s1"
+echo '{"mine": true}' > "$tmp/bs/subjects/s1/status.json"
+expect_rc 2 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/bs" -q
+grep -q "refusing to overwrite .*subjects/s1/status.json, which articula batch did not write" "$tmp/err" ||
+  fail "batch: status.json not named: $(cat "$tmp/err")"
+[ "$(cat "$tmp/bs/subjects/s1/status.json")" = '{"mine": true}' ] || fail "batch replaced the user's status.json"
+expect_rc 0 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/bs" -q --force
+grep -q '"command"' "$tmp/bs/subjects/s1/status.json" || fail "batch --force did not replace status.json"
+
+# One run per output folder: a second run on the folder of a running one is
+# refused at once (exit 1) naming the folder and the first's pid, and the
+# first completes. The first is paused once it holds the lock, so that it
+# cannot finish before the second starts.
+l="$tmp/l"
+"$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q & first=$!
+for _ in $(seq 500); do [ -s "$l/.articula/lock" ] && break; sleep 0.02; done
+kill -STOP "$first"
+expect_rc 1 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q
+kill -CONT "$first"
+grep -q "output folder '$l' is in use by articula run (pid $first)" "$tmp/err" || fail "second run: $(cat "$tmp/err")"
+wait "$first" || fail "the first run failed beside the refused second"
+[ -e "$l/results.json" ] || fail "the first run did not finish"
+# A killed run leaves no lock: the next run proceeds (and resumes).
+rm -rf "$l"
+"$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q & killed=$!
+for _ in $(seq 500); do [ -s "$l/.articula/lock" ] && break; sleep 0.02; done
+kill -9 "$killed"
+{ wait "$killed"; } 2>/dev/null && fail "the killed run exited 0" || true
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q
+[ -e "$l/results.json" ] || fail "the run after a killed one did not finish"
+# batch: one per study folder, the same way.
+mkdir -p "$tmp/busy/.articula"
+exec 9>>"$tmp/busy/.articula/lock"
+flock 9
+expect_rc 1 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/busy" -q
+grep -q "output folder '$tmp/busy' is in use" "$tmp/err" || fail "batch on a locked study folder: $(cat "$tmp/err")"
+exec 9>&-
+expect_rc 0 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/busy" -q
+
+# A run that fails before writing any output leaves nothing of itself: no
+# .articula, and no output folder it made; in a folder of the user's (an
+# input DICOM folder) neither.
+echo "not a CT" > "$tmp/junk.nii"
+expect_rc 3 "$bin/articula" run -i "$tmp/junk.nii" -o "$tmp/new" -q
+[ ! -e "$tmp/new" ] || fail "a failed run left its output folder: $(ls -A "$tmp/new")"
+mkdir -p "$tmp/mine"
+expect_rc 3 "$bin/articula" run -i "$tmp/junk.nii" -o "$tmp/mine" -q
+[ -z "$(ls -A "$tmp/mine")" ] || fail "a failed run left: $(ls -A "$tmp/mine")"
+expect_rc 2 "$bin/articula" run -i "$p/dicom" -o "$p/dicom" -q
+[ ! -e "$p/dicom/.articula" ] || fail "a failed run left .articula in the input DICOM folder"
+# One that failed after a stage wrote keeps its stamps: the next resumes.
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/part" --until sample -q
+expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/part" --models nosuch -q
+[ -e "$tmp/part/.articula/sample.json" ] || fail "a failed run removed the stamps of the stages it had done"
+
 echo "user files: ok"

@@ -1,15 +1,22 @@
-// lib/core: atomic writes and the clean-up of temporaries a killed run leaves.
+// lib/core: atomic writes and the clean-up of temporaries a killed run leaves;
+// the output folder's lock; the encoding check of text tables.
 #include <filesystem>
+#include <csignal>
 #include <fstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "articula/core/atomic_file.hpp"
+#include "articula/core/csv.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/output_lock.hpp"
 
 namespace articula {
 namespace {
@@ -75,6 +82,89 @@ TEST(AtomicFile, OnlyTheTemporariesOfDeadWritersAreRemoved) {
   EXPECT_FALSE(fs::exists(dir / "errors" / (ours + dead + "-summary.csv")));
   for (const fs::path& p : kept) EXPECT_TRUE(fs::exists(p)) << p;
   EXPECT_EQ(removeStaleTemporaries(dir / "nowhere"), 0);
+}
+
+
+TEST(OutputLock, ASecondHolderIsRefusedNamingTheFirst) {
+  const fs::path dir = scratch("lock") / "out";
+  {
+    OutputLock first(dir, "articula run");
+    EXPECT_TRUE(fs::exists(dir / ".articula" / "lock"));
+    EXPECT_NE(slurp(dir / ".articula" / "lock").find("(pid " + std::to_string(::getpid()) + ")"), std::string::npos);
+    // Another open file description, as another process has: refused.
+    try {
+      OutputLock second(dir, "articula run");
+      FAIL() << "a second lock on the same folder was granted";
+    } catch (const ProcessingError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("'" + dir.string() + "' is in use by articula run (pid "), std::string::npos) << message;
+    }
+  }
+  OutputLock again(dir, "articula run");  // released with its holder
+}
+
+TEST(OutputLock, AKilledHolderLeavesNoLock) {
+  const fs::path dir = scratch("lock-killed");
+  const pid_t child = ::fork();
+  if (child == 0) {
+    OutputLock held(dir, "child");
+    ::pause();
+    ::_exit(0);
+  }
+  for (int i = 0; i < 500 && slurp(dir / ".articula" / "lock").empty(); ++i) ::usleep(2000);
+  EXPECT_THROW(OutputLock(dir, "parent"), ProcessingError);
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  EXPECT_NO_THROW(OutputLock(dir, "parent"));
+}
+
+TEST(OutputLock, RemovesOnlyWhatItMade) {
+  const fs::path base = scratch("lock-made");
+  {
+    OutputLock lock(base / "new", "run");
+    lock.removeIfUnused();
+  }
+  EXPECT_FALSE(fs::exists(base / "new"));
+  fs::create_directories(base / "mine");
+  {
+    OutputLock lock(base / "mine", "run");
+    lock.removeIfUnused();
+  }
+  EXPECT_TRUE(fs::is_directory(base / "mine"));
+  EXPECT_TRUE(fs::is_empty(base / "mine"));
+  {
+    OutputLock lock(base / "written", "run");
+    std::ofstream(base / "written" / ".articula" / "segment.json") << "{}\n";
+    lock.removeIfUnused();
+  }
+  EXPECT_TRUE(fs::exists(base / "written" / ".articula" / "segment.json"));
+  EXPECT_FALSE(fs::exists(base / "written" / ".articula" / "lock"));
+}
+
+TEST(CsvEncoding, Utf16AndNulBytesAreRefusedAUtf8MarkIsAccepted) {
+  const fs::path dir = scratch("csv");
+  const auto write = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    return dir / name;
+  };
+  const CsvTable table = readCsv(write("bom8.csv", "\xEF\xBB\xBFsubject,input\ns1,a.nii\n"));
+  EXPECT_EQ(table.header.at(0), "subject");
+  ASSERT_EQ(table.rows.size(), 1u);
+  const std::string le("\xFF\xFEs\0,\0i\0\n\0", 10), be("\xFE\xFF\0s\0,\0i\0\n", 10);
+  const std::string nul("subject,input\ns1,a\0b\n", 21);
+  for (const auto& [name, bytes, line] : {std::tuple<std::string, std::string, int>{"le.csv", le, 1},
+                                          {"be.csv", be, 1},
+                                          {"nul.csv", nul, 2}}) {
+    try {
+      readCsv(write(name, bytes));
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), (dir / name).string() + ":" + std::to_string(line) +
+                                           ": the file is UTF-16 (or has NUL bytes); save it as UTF-8 CSV "
+                                           "(in Excel: Save As, 'CSV UTF-8')");
+    }
+  }
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "articula/cli/command.hpp"
 
+#include <charconv>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <new>
 #include <thread>
@@ -16,6 +18,28 @@ namespace articula::cli {
 
 int CommonOptions::threadCount() const { return threads > 0 ? threads : workerThreads(); }
 
+namespace {
+
+// CLI11 2.1 reads a 64-bit integer with strtoll and keeps its clamped value
+// (and takes 0x.. and a leading 0 as hexadecimal and octal): check the text.
+CLI::Validator integerIn(long long lo, long long hi) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        long long value = 0;
+        const char* end = text.data() + text.size();
+        const auto [next, error] = std::from_chars(text.data(), end, value);
+        if (error == std::errc() && next == end && value >= lo && value <= hi) {
+          text = std::to_string(value);  // "010" is ten, not CLI11's octal eight
+          return "";
+        }
+        return "expected a whole number in " + range + ", found '" + excerpt(text, 40) + "'";
+      },
+      range);
+}
+
+}  // namespace
+
 void addCommonOptions(CLI::App& app, CommonOptions& common) {
   app.set_version_flag("--version", versionString());
   app.set_config("--config", "", "Read option values from a TOML/INI file (CLI11 format)");
@@ -23,6 +47,7 @@ void addCommonOptions(CLI::App& app, CommonOptions& common) {
   app.add_flag_callback("-v,--verbose", [&common] { common.verbosity = 2; }, "Print debug messages")
       ->excludes(quiet);
   app.add_option("--seed", common.seed, "Seed of every random choice (same seed, same output)")
+      ->transform(integerIn(0, std::numeric_limits<long long>::max()))
       ->capture_default_str();
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024))
@@ -79,7 +104,6 @@ int guarded(Body&& body) {
 void applyCommon(const CommonOptions& common) {
   log::setLevel(static_cast<log::Level>(common.verbosity));
   setWorkerThreads(common.threads);
-  if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer, found " + std::to_string(common.seed));
 }
 
 // CLI11 reports usage errors itself; normalise its exit codes to ours.
@@ -173,6 +197,14 @@ void refuseToOverwrite(const std::vector<std::string>& existing, const std::stri
   std::string list;
   for (const auto& file : existing) list += (list.empty() ? "" : ", ") + file;
   throw UsageError("refusing to overwrite " + list + advice);
+}
+
+void refuseExistingOutputs(const std::vector<std::filesystem::path>& files, bool force) {
+  if (force) return;
+  std::vector<std::string> existing;
+  for (const auto& file : files)
+    if (std::filesystem::exists(file)) existing.push_back(file.string());
+  refuseToOverwrite(existing, " (use --force)");
 }
 
 std::string argumentProblem(const std::string& name, const std::vector<std::string>& args) {

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "articula/core/error.hpp"
+#include "articula/core/text_check.hpp"
 
 namespace articula {
 
@@ -34,6 +35,7 @@ std::vector<std::string> splitRecord(std::string line, std::istream& in, int& li
       if (!std::getline(in, next))
         throw InputError(path.string() + ":" + std::to_string(start_line) + ": unterminated quoted field");
       ++line_number;
+      checkTextLine(next, line_number, path);
       field += '\n';
       line = next;
       i = static_cast<size_t>(-1);
@@ -73,8 +75,7 @@ CsvTable readCsv(const std::filesystem::path& path, const CsvReadOptions& option
   bool have_header = false;
   while (std::getline(in, line)) {
     ++line_number;
-    // Spreadsheets save CSV with a UTF-8 byte-order mark; it is no part of the first field.
-    if (line_number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+    checkTextLine(line, line_number, path);
     const std::string t = trim(line);
     if (t.empty() || t[0] == '#') continue;
     const int record_line = line_number;

@@ -81,6 +81,19 @@ std::vector<std::string> runArguments(const Subject& s, const BatchOptions& opti
   return args;
 }
 
+std::vector<std::string> subjectFilesNotOurs(const std::vector<Subject>& subjects, const fs::path& study_dir) {
+  std::vector<std::string> others;
+  for (const auto& s : subjects) {
+    const fs::path dir = subjectDir(study_dir, s.id);
+    const auto status = readJsonFileIfValid(dir / "status.json");
+    const bool record = status && status->is_object() && status->value("subject", "") == s.id && status->contains("command");
+    if (fs::exists(dir / "status.json") && !record) others.push_back((dir / "status.json").string());
+    if (fs::exists(dir / "run.log") && !record && !fs::is_directory(dir / ".articula"))
+      others.push_back((dir / "run.log").string());
+  }
+  return others;
+}
+
 BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& options) {
   if (options.jobs < 1) throw UsageError("-j: expected at least 1 job, found " + std::to_string(options.jobs));
   const auto batch_start = std::chrono::steady_clock::now();

@@ -1,5 +1,10 @@
 #include "articula/pipeline/stages.hpp"
 
+#include <fnmatch.h>
+
+#include <algorithm>
+
+#include <system_error>
 #include <utility>
 
 #include "articula/core/error.hpp"
@@ -13,38 +18,45 @@ const std::vector<StageDescription>& stages() {
        {"seed-point", "series-uid", "hu-min", "hu-max", "roi", "level-set"},
        {"CT"},
        {"label.nii.gz"},
-       {"-i", "{CT}", "-o", "{folder}/label.nii.gz", "--joint", "{joint}", "--side", "{side}"}},
+       {"-i", "{CT}", "-o", "{folder}/label.nii.gz", "--joint", "{joint}", "--side", "{side}"},
+       {"label.nii.gz.json"}},
       // The CT too: the surface moves onto its bone edge (sub-voxel).
       {"mesh",
        "Marching cubes and smoothing of the label, moved onto the CT's bone edge",
        {"series-uid", "smoothing", "smooth-iterations", "relaxation", "decimate", "edge-model", "point-spread", "slice-point-spread"},
        {"label.nii.gz", "CT"},
        {"bone.vtp"},
-       {"-i", "{folder}/label.nii.gz", "-o", "{folder}/bone.vtp", "--ct", "{CT}"}},
+       {"-i", "{folder}/label.nii.gz", "-o", "{folder}/bone.vtp", "--ct", "{CT}"},
+       {"bone.vtp.json"}},
       {"sample",
        "Articular surface of the mesh, Gaussian-downsampled to points with normals",
        {"select", "ball-radius", "ratio"},
        {"bone.vtp"},
        {"points.ply"},
-       {"-i", "{folder}/bone.vtp", "-o", "{folder}/points.ply"}},
+       {"-i", "{folder}/bone.vtp", "-o", "{folder}/points.ply"},
+       {"points.ply.json"}},
       {"fit",
        "The shape-model hierarchy fitted to the points",
        {"models", "objective"},
        {"points.ply"},
        {"fits.json", "fits.csv"},
-       {"-i", "{folder}/points.ply", "-o", "{folder}/fits.json"}},
+       {"-i", "{folder}/points.ply", "-o", "{folder}/fits.json"},
+       {}},
       {"errors",
        "Signed Euclidean errors of every fitted model",
        {},
        {"points.ply", "fits.json"},
        {"errors/summary.json", "errors/histogram.svg", "errors/error_map.svg"},
-       {"-i", "{folder}/points.ply", "--fits", "{folder}/fits.json", "-o", "{folder}/errors"}},
+       {"-i", "{folder}/points.ply", "--fits", "{folder}/fits.json", "-o", "{folder}/errors"},
+       {"errors/summary.csv", "errors/errors.csv", "errors/points_*.ply", "errors/points_*.vtp", "errors/surface_*.ply",
+        "errors/.errors-incomplete"}},
       {"report",
        "Results, the selected model and the head's checks from the stage outputs",
        {"series-uid", "selection-tolerance", "selection-floor"},
        {"fits.json", "errors/summary.json", "points.ply"},
        {"results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"},
-       {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"}},
+       {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"},
+       {"slicer/*.mrk.json"}},
   };
   return table;
 }
@@ -84,6 +96,36 @@ std::vector<std::string> expandArguments(const StageDescription& stage, const st
   return out;
 }
 
+bool matchesFilePattern(const std::string& pattern, const std::string& file) {
+  return ::fnmatch(pattern.c_str(), file.c_str(), FNM_PATHNAME) == 0;
+}
+
+bool isStageFile(const StageDescription& stage, const std::string& file) {
+  for (const auto& out : stage.outputs)
+    if (out == file) return true;
+  for (const auto& pattern : stage.sidecars)
+    if (matchesFilePattern(pattern, file)) return true;
+  return false;
+}
+
+std::vector<std::string> stageFilesIn(const StageDescription& stage, const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> found;
+  std::error_code ec;
+  std::vector<fs::path> places = {folder};
+  for (const auto& name : stage.outputs) places.push_back((folder / name).parent_path());
+  for (const auto& name : stage.sidecars) places.push_back((folder / name).parent_path());
+  std::sort(places.begin(), places.end());
+  places.erase(std::unique(places.begin(), places.end()), places.end());
+  for (const fs::path& place : places)
+    for (auto it = fs::directory_iterator(place, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+      const std::string name = it->path().lexically_relative(folder).generic_string();
+      if (isStageFile(stage, name)) found.push_back(name);
+    }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 nlohmann::json stagesJson() {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& s : stages())
@@ -92,7 +134,8 @@ nlohmann::json stagesJson() {
                     {"options", s.options},
                     {"inputs", s.inputs},
                     {"outputs", s.outputs},
-                    {"arguments", s.arguments}});
+                    {"arguments", s.arguments},
+                    {"sidecars", s.sidecars}});
   return {{"stages", list}};
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "articula/core/error.hpp"
+#include "articula/core/text_check.hpp"
 #include "readers.hpp"
 
 namespace articula::points::detail {
@@ -116,6 +117,7 @@ PointCloud readTable(const std::filesystem::path& path) {
   bool seen_content = false;
   while (std::getline(in, raw)) {
     ++line_number;
+    checkTextLine(raw, line_number, path);
     const std::string line = trim(raw);
     if (line.empty() || line[0] == '#') continue;
     std::vector<std::string> fields = splitFields(line);

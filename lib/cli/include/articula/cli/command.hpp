@@ -3,6 +3,7 @@
 // options in one place (declare), then does its work (run). One shared main
 // adds the standard options, parses, and maps exceptions to exit codes, so
 // `articula-fit ...` and `articula fit ...` behave identically.
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -82,6 +83,11 @@ std::string argumentProblem(const std::string& name, const std::vector<std::stri
 /// Throws UsageError "refusing to overwrite A, B<advice>" when `existing`
 /// (outputs found before any work) is not empty: every one named at once.
 void refuseToOverwrite(const std::vector<std::string>& existing, const std::string& advice);
+
+/// Unless `force`, refuses (as refuseToOverwrite, advising --force) those of
+/// `files` that exist: a command's outputs and what it writes beside them
+/// (a provenance .json, a table), named together before any work.
+void refuseExistingOutputs(const std::vector<std::filesystem::path>& files, bool force);
 
 /// Prints a JSON summary on stdout (for --json).
 void printJson(const nlohmann::json& summary);

@@ -44,6 +44,13 @@ std::filesystem::path subjectDir(const std::filesystem::path& study_dir, const s
 std::vector<std::string> runArguments(const Subject& subject, const BatchOptions& options);
 
 /// Runs every subject; never throws for a failing subject.
+/// The files a batch writes beside each subject's run (run.log, status.json)
+/// that exist but that no batch wrote: a status.json that is not a batch's
+/// record of that subject, a run.log in a folder with neither such a record
+/// nor run's stamps (.articula). Full paths, for refuseToOverwrite.
+std::vector<std::string> subjectFilesNotOurs(const std::vector<Subject>& subjects,
+                                             const std::filesystem::path& study_dir);
+
 BatchSummary runBatch(const std::vector<Subject>& subjects, const BatchOptions& options);
 
 /// The outcomes recorded in the subjects' folders (status.json; a subject

@@ -6,6 +6,7 @@
 // it, `articula stages --json` prints it, and pipelines/Snakefile makes one
 // rule per stage from that print. Adding a stage: its command in apps/, one
 // row here.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,11 @@ struct StageDescription {
   /// Its command line in a subject's folder, without the standard options:
   /// {CT} the subject's input, {folder} its folder, {joint} and {side}.
   std::vector<std::string> arguments;
+  /// What it writes beside its outputs (provenance .json, tables, per-model
+  /// files; '*' for a model's name), in the subject folder: neither inputs
+  /// of later stages nor Snakemake targets, but replaced by a rerun all the
+  /// same, so `articula run` checks them as it checks the outputs.
+  std::vector<std::string> sidecars;
 };
 
 /// The arguments with {CT}, {folder}, {joint} and {side} replaced.
@@ -37,7 +43,18 @@ const StageDescription& stageNamed(const std::string& name);
 /// The stage names joined by ", " (for help texts).
 std::string stageNames();
 
-/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments"}, ...]}
+/// Whether `file` matches a sidecar's name, '*' standing for any part of
+/// one path component.
+bool matchesFilePattern(const std::string& pattern, const std::string& file);
+
+/// Whether `file` (relative to the subject folder, '/'-separated) is one of
+/// the stage's outputs or matches one of its sidecars.
+bool isStageFile(const StageDescription& stage, const std::string& file);
+
+/// The stage's outputs and sidecars that exist in `folder`, relative to it, sorted.
+std::vector<std::string> stageFilesIn(const StageDescription& stage, const std::filesystem::path& folder);
+
+/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments", "sidecars"}, ...]}
 nlohmann::json stagesJson();
 
 }  // namespace articula::pipeline
