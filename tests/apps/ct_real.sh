@@ -42,5 +42,30 @@ if [[ -d "$D/ct/abdomen-j2k-dicom" ]]; then
   expect_rc 1 "$B/articula-segment" -i "$D/ct/abdomen-j2k-dicom" -o "$T/abdomen.nii.gz"
   grep -q "no femoral head found" "$tmp/err" || fail "abdomen: $(cat "$tmp/err")"
   [[ ! -e "$T/abdomen.nii.gz" ]] || fail "abdomen: a label was written"
+  # One slice whose JPEG 2000 codestream lost its second half, in a file
+  # that is whole (its fragment's length says so): OpenJPEG decoded what was
+  # left without a word. Refused by name.
+  cp -r "$D/ct/abdomen-j2k-dicom" "$T/j2k-cut"
+  slice=$(ls "$T/j2k-cut" | sed -n 10p)
+  python3 - "$T/j2k-cut/$slice" <<'PY'
+import struct, sys
+path = sys.argv[1]
+b = open(path, "rb").read()
+at = b.rindex(b"\xe0\x7f\x10\x00OB\x00\x00\xff\xff\xff\xff") + 12
+items, pos = [], at
+while True:
+    tag, length = struct.unpack_from("<II", b, pos)
+    if tag == 0xE0DDFFFE:
+        break
+    items.append(b[pos + 8:pos + 8 + length])
+    pos += 8 + length
+stream = b"".join(items[1:])
+cut = stream[: len(stream) // 2 // 2 * 2]
+out = b[:at] + struct.pack("<HHI", 0xFFFE, 0xE000, len(items[0])) + items[0]
+out += struct.pack("<HHI", 0xFFFE, 0xE000, len(cut)) + cut + struct.pack("<HHI", 0xFFFE, 0xE0DD, 0)
+open(path, "wb").write(out)
+PY
+  expect_rc 3 "$B/articula-segment" -i "$T/j2k-cut" -o "$T/j2k-cut.nii.gz"
+  grep -q "^  $slice: its JPEG 2000 codestream is cut short" "$tmp/err" || fail "cut JPEG 2000: $(cat "$tmp/err")"
 fi
 echo "real CTs: ok"

@@ -19,6 +19,19 @@ namespace articula::imaging {
 
 namespace {
 
+std::vector<double> numbers(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, '\\')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (end == item.c_str() || !std::isfinite(v)) return {};
+    out.push_back(v);
+  }
+  return out;
+}
+
 constexpr std::uint32_t kUndefinedLength = 0xFFFFFFFFu;
 constexpr std::uint32_t kPixelData = 0x7FE00010u;
 constexpr std::uint32_t kItem = 0xFFFEE000u, kItemEnd = 0xFFFEE00Du, kSequenceEnd = 0xFFFEE0DDu;
@@ -115,6 +128,9 @@ class Walker {
         throw Broken("expected an item in element " + tagName(owner) + " at byte " + std::to_string(start) + ", found " +
                      tagName(tag));
       if (length != kUndefinedLength) {
+        // The fragments of the slice's compressed pixel data (the first item
+        // is the offset table), kept to check the codestream they form.
+        if (owner == kPixelData && depth == 1 && header) fragments.push_back({pos_, length});
         skip(length, owner, start);
         continue;
       }
@@ -200,6 +216,7 @@ class Walker {
 
  public:
   DicomSliceHeader* header = nullptr;  // where to note the slice header, if anywhere
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> fragments;  // of the top-level pixel data: where, how long
 
  private:
   std::uint64_t pos_ = 0;
@@ -207,6 +224,68 @@ class Walker {
  public:
   void seek(std::uint64_t to) { pos_ = to; }
 };
+
+// What a decoder would not say of a compressed slice: OpenJPEG decodes a
+// JPEG 2000 codestream cut short (or with a tile-part removed) from what is
+// left, filling the rest with a coarser image, and libjpeg pads a JPEG cut
+// short. Only the structure is checked (every marker segment and tile-part
+// within the stream, the end marker last); damage inside the entropy-coded
+// data has no marker to show it.
+std::string jpeg2000Problem(const std::string& s) {
+  const auto u16 = [&](size_t at) { return unsigned(static_cast<unsigned char>(s[at])) << 8 | static_cast<unsigned char>(s[at + 1]); };
+  if (s.size() < 4 || u16(0) != 0xFF4F || u16(2) != 0xFF51)
+    return "its JPEG 2000 codestream does not begin with the SOC and SIZ markers";
+  size_t at = 2;
+  while (at + 4 <= s.size() && u16(at) != 0xFF90) {  // the main header's marker segments, to the first tile-part
+    if ((u16(at) & 0xFF00) != 0xFF00) return "its JPEG 2000 main header is broken at byte " + std::to_string(at);
+    at += 2 + u16(at + 2);
+  }
+  for (;;) {
+    if (at + 2 > s.size()) return "its JPEG 2000 codestream is cut short (no EOC marker after its last tile-part)";
+    if (u16(at) == 0xFFD9) break;
+    if (u16(at) != 0xFF90 || at + 12 > s.size())
+      return "its JPEG 2000 codestream is broken at byte " + std::to_string(at) + " (expected a tile-part or EOC)";
+    const std::uint64_t psot = std::uint64_t(u16(at + 6)) << 16 | u16(at + 8);
+    if (psot == 0) return s.size() >= 2 && u16(s.size() - 2) == 0xFFD9 ? "" : "its JPEG 2000 codestream is cut short";
+    if (at + psot > s.size())
+      return "its JPEG 2000 codestream is cut short: a tile-part at byte " + std::to_string(at) + " announces " +
+             std::to_string(psot) + " bytes, " + std::to_string(s.size() - at) + " remain";
+    at += psot;
+  }
+  for (at += 2; at < s.size(); ++at)  // the fragment's even-length padding
+    if (s[at] != '\0') return "its JPEG 2000 codestream has bytes after its EOC marker";
+  return "";
+}
+
+std::string jpegProblem(const std::string& s) {
+  size_t end = s.size();
+  while (end > 0 && s[end - 1] == '\0') --end;  // padding to an even length
+  if (end < 4 || static_cast<unsigned char>(s[0]) != 0xFF || static_cast<unsigned char>(s[1]) != 0xD8)
+    return "its JPEG data does not begin with the SOI marker";
+  if (static_cast<unsigned char>(s[end - 2]) != 0xFF || static_cast<unsigned char>(s[end - 1]) != 0xD9)
+    return "its JPEG data is cut short (no EOI marker at its end)";
+  return "";
+}
+
+// The codestream of a single-frame slice (its fragments after the offset
+// table, joined), for the transfer syntaxes whose structure is checked.
+std::string codestreamProblem(std::ifstream& in, const std::string& syntax,
+                              const std::vector<std::pair<std::uint64_t, std::uint32_t>>& fragments) {
+  const bool j2k = syntax == "1.2.840.10008.1.2.4.90" || syntax == "1.2.840.10008.1.2.4.91";
+  const bool jpeg = syntax == "1.2.840.10008.1.2.4.50" || syntax == "1.2.840.10008.1.2.4.51" ||
+                    syntax == "1.2.840.10008.1.2.4.57" || syntax == "1.2.840.10008.1.2.4.70";
+  if ((!j2k && !jpeg) || fragments.size() < 2) return "";
+  std::string stream;
+  for (size_t f = 1; f < fragments.size(); ++f) {
+    std::string part(fragments[f].second, '\0');
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(fragments[f].first));
+    in.read(part.data(), static_cast<std::streamsize>(part.size()));
+    if (!in) return "a read of its pixel data failed";
+    stream += part;
+  }
+  return j2k ? jpeg2000Problem(stream) : jpegProblem(stream);
+}
 
 }  // namespace
 
@@ -259,6 +338,9 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
     }
     // Zero bytes after the last element are padding some writers leave; GDCM stops there too.
     while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
+    const std::vector<double> frames = numbers(result.header.frames);
+    if (frames.size() <= 1 && (frames.empty() || frames[0] <= 1))
+      if (const std::string problem = codestreamProblem(in, syntax, walk.fragments); !problem.empty()) throw Broken(problem);
     result.kind = DicomFileKind::Complete;
     result.header.read = true;
   } catch (const Broken& e) {
@@ -278,18 +360,6 @@ using Vec3 = std::array<double, 3>;
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-std::vector<double> numbers(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, '\\')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || !std::isfinite(v)) return {};
-    out.push_back(v);
-  }
-  return out;
-}
 
 std::string number(double v) {
   std::ostringstream out;
