@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -175,6 +176,9 @@ class Walker {
       case 0x00280030u: text = &header->pixel_spacing; break;
       case 0x00281053u: text = &header->rescale_slope; break;
       case 0x00280008u: text = &header->frames; break;
+      case 0x0020000Eu: text = &header->series_uid; break;
+      case 0x00080060u: text = &header->modality; break;
+      case 0x0008103Eu: text = &header->description; break;
       case 0x00280010u: count = &header->rows; break;
       case 0x00280011u: count = &header->columns; break;
       case 0x00280100u: count = &header->bits_allocated; break;
@@ -507,6 +511,56 @@ void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector
       throw InputError(m.str());
     }
   }
+}
+
+DicomFolder scanDicomFolder(const std::filesystem::path& folder) {
+  DicomFolder out;
+  std::vector<std::filesystem::path> paths;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
+    if (entry.is_regular_file(ec)) paths.push_back(entry.path());
+  std::sort(paths.begin(), paths.end());
+  std::map<std::string, DicomFolder::Series> by_uid;
+  for (const auto& path : paths) {
+    const std::string file_name = path.filename().string();
+    DicomFileCheck check = checkDicomFile(path);
+    if (check.kind == DicomFileKind::Damaged) {
+      if (++out.damaged_count <= 5) out.damaged.push_back(excerpt(file_name) + ": " + check.problem);
+      continue;
+    }
+    if (!check.header.read || check.header.pixel_data_bytes == -1) {
+      out.other_files.push_back(file_name);
+      continue;
+    }
+    DicomFolder::Series& series = by_uid[check.header.series_uid];
+    if (series.files.empty()) {
+      series.uid = check.header.series_uid;
+      series.modality = check.header.modality;
+      series.description = check.header.description;
+    }
+    series.files.push_back(path.string());
+    series.headers.push_back(std::move(check.header));
+  }
+  for (auto& [uid, series] : by_uid) {
+    const std::vector<double> o = numbers(series.headers.front().orientation);
+    if (o.size() == 6) {
+      const Vec3 normal{o[1] * o[5] - o[2] * o[4], o[2] * o[3] - o[0] * o[5], o[0] * o[4] - o[1] * o[3]};
+      std::vector<std::pair<double, size_t>> order;
+      for (size_t k = 0; k < series.files.size(); ++k) {
+        const std::vector<double> p = numbers(series.headers[k].position);
+        order.emplace_back(p.size() == 3 ? dot({p[0], p[1], p[2]}, normal) : 0.0, k);
+      }
+      std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      DicomFolder::Series sorted = series;
+      for (size_t k = 0; k < order.size(); ++k) {
+        sorted.files[k] = series.files[order[k].second];
+        sorted.headers[k] = series.headers[order[k].second];
+      }
+      series = std::move(sorted);
+    }
+    out.series.push_back(std::move(series));
+  }
+  return out;
 }
 
 }  // namespace articula::imaging

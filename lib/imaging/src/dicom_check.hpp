@@ -25,6 +25,7 @@ enum class DicomFileKind {
 struct DicomSliceHeader {
   bool read = false;  // the data set was walked to its end
   std::string position, orientation, pixel_spacing, rescale_slope, frames;  // DS/IS text
+  std::string series_uid, modality, description;
   long rows = -1, columns = -1, bits_allocated = -1, samples_per_pixel = -1;
   static constexpr std::int64_t kEncapsulated = -2;
   std::int64_t pixel_data_bytes = -1;  // -1: no Pixel Data; kEncapsulated: compressed fragments
@@ -37,6 +38,25 @@ struct DicomFileCheck {
 };
 
 DicomFileCheck checkDicomFile(const std::filesystem::path& file);
+
+/// A folder's DICOM images as series, from the walk alone: GDCM then reads
+/// only files that passed it (it aborts the process on some it cannot parse,
+/// and takes files of any content for DICOM). Images (files with pixel data)
+/// are grouped by Series Instance UID, in UID order; each series' files are
+/// in order along the slice normal of its first file (by name), then by name.
+struct DicomFolder {
+  struct Series {
+    std::string uid;  // empty for files whose UID is empty
+    std::string modality, description;
+    std::vector<std::string> files;  // paths
+    std::vector<DicomSliceHeader> headers;
+  };
+  std::vector<Series> series;
+  std::vector<std::string> other_files;  // names: no DICOM, or DICOM without pixel data
+  std::vector<std::string> damaged;      // "name: problem", the first five
+  int damaged_count = 0;
+};
+DicomFolder scanDicomFolder(const std::filesystem::path& folder);
 
 /// Every slice of a series against the first, before ITK assembles them: ITK
 /// takes the size, spacing and orientation of the first slice (and positions

@@ -15,7 +15,6 @@
 #include <gdcmTrace.h>
 #include <gdcmUIDGenerator.h>
 #include <itkGDCMImageIO.h>
-#include <itkGDCMSeriesFileNames.h>
 #include <itkImage.h>
 #include <itkMultiThreaderBase.h>
 #include <cerrno>
@@ -273,15 +272,6 @@ void checkNiftiFile(const fs::path& path) {
 
 namespace {
 
-/// Modality and description of a series from its first file's header.
-void readHeader(const std::string& file, std::string& modality, std::string& description) {
-  auto io = itk::GDCMImageIO::New();
-  io->SetFileName(file);
-  io->ReadImageInformation();
-  modality = tagValue(io->GetMetaDataDictionary(), "0008|0060");
-  description = tagValue(io->GetMetaDataDictionary(), "0008|103e");
-}
-
 std::string seriesList(const std::vector<SeriesInfo>& series) {
   std::string out;
   for (const auto& s : series)
@@ -356,28 +346,22 @@ void checkSlices(const std::vector<std::string>& files, const itk::ImageSeriesRe
   spacing_out = std::fabs(median);
 }
 
-// Files of the folder in no series (GDCM could not read them): named in a
-// warning, and in the message when the series then lacks a slice.
-void noteUnreadableFiles(const fs::path& folder, itk::GDCMSeriesFileNames& names, ReadReport& report) {
-  std::set<std::string> in_series;
-  for (const std::string& uid : names.GetSeriesUIDs())
-    for (const std::string& f : names.GetFileNames(uid)) in_series.insert(fs::path(f).filename().string());
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(folder, ec))
-    if (entry.is_regular_file(ec) && !in_series.count(entry.path().filename().string()))
-      report.unreadable_files.push_back(entry.path().filename().string());
-  std::sort(report.unreadable_files.begin(), report.unreadable_files.end());
+// Files of the folder in no series (no DICOM image): named in a warning,
+// and in the message when the series then lacks a slice.
+void noteUnreadableFiles(const fs::path& folder, const DicomFolder& scan, ReadReport& report) {
+  report.unreadable_files = scan.other_files;
   if (!report.unreadable_files.empty())
     log::warn(std::to_string(report.unreadable_files.size()) + " file(s) of " + folder.string() +
-              " are in no DICOM series (not DICOM, or unreadable): " + unreadableList(report));
+              " are in no DICOM series (not DICOM, no image, or unreadable): " + unreadableList(report));
 }
+
+DicomFolder scanSeries(const fs::path& folder);
+std::vector<SeriesInfo> seriesOf(const DicomFolder& scan);
 
 Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport& report) {
   report.source = "dicom";
-  report.series = listDicomSeries(folder);
-  auto names = itk::GDCMSeriesFileNames::New();
-  names->SetUseSeriesDetails(false);
-  names->SetDirectory(folder.string());
+  const DicomFolder scan = scanSeries(folder);
+  report.series = seriesOf(scan);
   const SeriesInfo* chosen = nullptr;
   if (!options.series_uid.empty()) {
     for (const auto& s : report.series)
@@ -405,13 +389,10 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
   report.series_uid = chosen->uid;
   report.modality = chosen->modality;
 
-  // GDCM keys its series by UID in a sorted map and GetFileNames("") gives
-  // the first, so "" names the series of empty UID exactly.
-  const std::vector<std::string> files = names->GetFileNames(chosen->uid == kEmptySeriesUid ? "" : chosen->uid);
-  noteUnreadableFiles(folder, *names, report);
-  std::vector<DicomSliceHeader> headers;
-  for (const std::string& file : files) headers.push_back(checkDicomFile(file).header);
-  checkSeriesHeaders(files, headers);
+  const DicomFolder::Series& slices = scan.series[static_cast<size_t>(chosen - report.series.data())];
+  const std::vector<std::string>& files = slices.files;
+  noteUnreadableFiles(folder, scan, report);
+  checkSeriesHeaders(files, slices.headers);
   using ReaderType = itk::ImageSeriesReader<itk::Image<float, 3>>;
   auto reader = ReaderType::New();
   auto io = itk::GDCMImageIO::New();
@@ -464,27 +445,50 @@ void checkDirection(const Eigen::Matrix3d& direction, const std::string& where) 
   }
 }
 
+std::string dicomFoldersBelow(const fs::path& folder);
+
 namespace {
-// Every file of the folder is checked before GDCM scans it (dicom_check.hpp):
-// a damaged DICOM file is refused by name; files that are no DICOM at all
-// (a README, a DICOMDIR without preamble) are left for GDCM to skip.
-void refuseDamagedDicomFiles(const fs::path& folder) {
-  std::vector<std::string> damaged;
-  int count = 0;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    if (!entry.is_regular_file(ec)) continue;
-    const DicomFileCheck check = checkDicomFile(entry.path());
-    if (check.kind != DicomFileKind::Damaged) continue;
-    if (++count <= 5) damaged.push_back(excerpt(entry.path().filename().string()) + ": " + check.problem);
+// Every file of the folder is walked (dicom_check.hpp) and GDCM reads only
+// the series found: a damaged DICOM file is refused by name; files that are
+// no DICOM image (a README, a DICOMDIR) are left out with a warning.
+
+DicomFolder scanSeries(const fs::path& folder) {
+  // GDCM prints its own errors and warnings (a tag it cannot parse) as raw
+  // lines; the checks here name the file and say what to do instead.
+  gdcm::Trace::ErrorOff();
+  gdcm::Trace::WarningOff();
+  // ITK's own warnings (e.g. on slices it skipped) would precede ours; what
+  // they say is checked and reported here.
+  itk::Object::GlobalWarningDisplayOff();
+  if (!fs::is_directory(folder)) throw InputError("expected a DICOM folder, found no folder at " + folder.string());
+  if (fs::is_empty(folder)) throw InputError("expected DICOM files in " + folder.string() + ", found an empty folder");
+  DicomFolder scan = scanDicomFolder(folder);
+  if (scan.damaged_count > 0) {
+    std::string list;
+    for (const auto& d : scan.damaged) list += "\n  " + d;
+    throw InputError("expected complete DICOM files in " + folder.string() + ", found " +
+                     std::to_string(scan.damaged_count) + " damaged (cut short or corrupted; replace or remove them):" +
+                     list + (scan.damaged_count > 5 ? "\n  ..." : ""));
   }
-  if (damaged.empty()) return;
-  std::string list;
-  for (const auto& d : damaged) list += "\n  " + d;
-  throw InputError("expected complete DICOM files in " + folder.string() + ", found " + std::to_string(count) +
-                   " damaged (cut short or corrupted; replace or remove them):" + list +
-                   (count > 5 ? "\n  ..." : ""));
+  if (scan.series.empty())
+    throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)" +
+                     dicomFoldersBelow(folder));
+  return scan;
 }
+
+std::vector<SeriesInfo> seriesOf(const DicomFolder& scan) {
+  std::vector<SeriesInfo> out;
+  for (const auto& series : scan.series) {
+    SeriesInfo s;
+    s.uid = series.uid.empty() ? kEmptySeriesUid : series.uid;  // choosable by name
+    s.files = static_cast<int>(series.files.size());
+    s.modality = series.modality;
+    s.description = series.description;
+    out.push_back(s);
+  }
+  return out;
+}
+
 }  // namespace
 
 // Up to three folders below `folder` (three levels deep, 200 folders at
@@ -517,39 +521,7 @@ std::string dicomFoldersBelow(const fs::path& folder) {
   return hint.empty() ? "" : hint + ": give that folder as the input";
 }
 
-std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) {
-  // GDCM prints its own errors and warnings (a position shared by two slices,
-  // a tag it cannot parse) as raw lines; the checks here name the file and say
-  // what to do instead.
-  gdcm::Trace::ErrorOff();
-  gdcm::Trace::WarningOff();
-  if (!fs::is_directory(folder)) throw InputError("expected a DICOM folder, found no folder at " + folder.string());
-  if (fs::is_empty(folder)) throw InputError("expected DICOM files in " + folder.string() + ", found an empty folder");
-  refuseDamagedDicomFiles(folder);
-  // ITK's own warnings (e.g. on slices it skipped) would precede ours; what
-  // they say is checked and reported here.
-  itk::Object::GlobalWarningDisplayOff();
-  std::vector<SeriesInfo> out;
-  try {
-    auto names = itk::GDCMSeriesFileNames::New();
-    names->SetUseSeriesDetails(false);
-    names->SetDirectory(folder.string());
-    for (const std::string& uid : names->GetSeriesUIDs()) {
-      SeriesInfo s;
-      s.uid = uid.empty() ? kEmptySeriesUid : uid;  // choosable by name
-      const auto files = names->GetFileNames(uid);
-      s.files = static_cast<int>(files.size());
-      if (!files.empty()) readHeader(files.front(), s.modality, s.description);
-      out.push_back(s);
-    }
-  } catch (const itk::ExceptionObject& e) {
-    throw InputError("could not scan " + folder.string() + " for DICOM files: " + e.GetDescription());
-  }
-  if (out.empty())
-    throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)" +
-                     dicomFoldersBelow(folder));
-  return out;
-}
+std::vector<SeriesInfo> listDicomSeries(const fs::path& folder) { return seriesOf(scanSeries(folder)); }
 
 void limitImagingThreads(int threads) {
   const auto n = static_cast<itk::ThreadIdType>(std::max(1, threads));
