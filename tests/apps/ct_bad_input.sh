@@ -159,11 +159,13 @@ open(f"{folder}/flat.mha", "wb").write(header("MET_SHORT") + struct.pack(f"<{n *
 open(f"{folder}/unsized-zlib.mha", "wb").write(header("MET_SHORT", "CompressedData = True\n") + packed)
 open(f"{folder}/ndims.mha", "wb").write(header("MET_SHORT").replace(b"NDims = 3", b"NDims = 2"))
 open(f"{folder}/twice.mha", "wb").write(header("MET_SHORT", "NDims = -10 20 30\n") + raw)
+open(f"{folder}/no-equals.mha", "wb").write(header("MET_SHORT").replace(b"NDims = 3", b"NDims") + raw)
 PY
 expect 3 "CompressedData = True without CompressedDataSize: .*expected the line CompressedDataSize = $(( $(stat -c %s "$T/unsized-zlib.mha") - $(grep -abo 'LOCAL' "$T/unsized-zlib.mha" | cut -d: -f1) - 6 ))" -- \
   "$B/articula-segment" -i "$T/unsized-zlib.mha" -o "$T/l.nii.gz"
 expect 3 "NDims = 2; expected NDims = 3" -- "$B/articula-segment" -i "$T/ndims.mha" -o "$T/l.nii.gz"
 expect 3 "gives 'NDims' twice" -- timeout 60 "$B/articula-segment" -i "$T/twice.mha" -o "$T/l.nii.gz"
+expect 3 "line 'NDims' has no '='" -- timeout 60 "$B/articula-segment" -i "$T/no-equals.mha" -o "$T/l.nii.gz"
 expect 3 "announces 27648 bytes of voxel data, the file holds 13824: the file is cut short" -- \
   "$B/articula-segment" -i "$T/cut.mha" -o "$T/l.nii.gz"
 expect 3 "compressed voxel data is damaged\|the file is cut short" -- "$B/articula-segment" -i "$T/cut-zlib.mha" -o "$T/l.nii.gz"

@@ -125,7 +125,13 @@ void checkMetaImage(const fs::path& path) {
   std::string line;
   while (std::getline(in, line) && in.tellg() < (1 << 20)) {
     const auto eq = line.find('=');
-    if (eq == std::string::npos) continue;
+    // MetaIO takes the words of a line without '=' for a key and reads on
+    // into the next lines for its value: such a header spun it for ever.
+    if (eq == std::string::npos) {
+      if (trimmed(line).empty()) continue;
+      throw InputError(path.string() + ": the MetaImage header's line '" + excerpt(trimmed(line), 60) +
+                       "' has no '='; expected 'Key = Value' lines up to ElementDataFile");
+    }
     const std::string key = trimmed(line.substr(0, eq));
     // MetaIO reads the fields in order, each sized by the NDims it has read
     // so far: a second NDims, or a second of any field, would make it read
