@@ -340,8 +340,12 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
       walk.big_endian = first_group == 0x0800;
       walk.explicit_vr = !walk.big_endian && std::isupper(first[4]) && std::isupper(first[5]);
     }
-    // Zero bytes after the last element are padding some writers leave; GDCM stops there too.
+    // Zero bytes after the last element are padding some writers leave; GDCM
+    // stops there too, but in a big-endian data set it aborts on them.
     while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
+    if (!walk.atEnd() && walk.big_endian)
+      throw Broken("zero bytes follow the last element of a big-endian data set, from byte " +
+                   std::to_string(walk.position()));
     const std::vector<double> frames = numbers(result.header.frames);
     if (frames.size() <= 1 && (frames.empty() || frames[0] <= 1))
       if (const std::string problem = codestreamProblem(in, syntax, walk.fragments); !problem.empty()) throw Broken(problem);

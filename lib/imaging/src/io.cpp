@@ -404,6 +404,9 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
   } catch (const itk::ExceptionObject& e) {
     throw InputError("could not decode the DICOM series " + chosen->uid + " in " + folder.string() +
                      " (unsupported transfer syntax or missing codec?): " + e.GetDescription());
+  } catch (const std::exception& e) {
+    throw InputError("could not decode the DICOM series " + chosen->uid + " in " + folder.string() + ": " +
+                     excerpt(e.what()));
   }
   double spacing_z = 0;
   checkSlices(files, *reader, options, report, spacing_z);

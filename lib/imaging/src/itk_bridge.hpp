@@ -15,6 +15,7 @@
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/excerpt.hpp"
 #include "articula/imaging/image.hpp"
 #include "image_file_check.hpp"
 
@@ -102,6 +103,8 @@ Image<T> readImageFile(const std::filesystem::path& path) {
       io->ReadImageInformation();
     } catch (const itk::ExceptionObject& e) {
       throw InputError("could not read the image header of " + path.string() + ": " + e.GetDescription());
+    } catch (const std::exception& e) {
+      throw InputError("could not read the image header of " + path.string() + ": " + excerpt(e.what()));
     }
     for (unsigned d = 3; d < io->GetNumberOfDimensions(); ++d)
       if (io->GetDimensions(d) > 1)
@@ -122,6 +125,10 @@ Image<T> readImageFile(const std::filesystem::path& path) {
     reader->Update();
   } catch (const itk::ExceptionObject& e) {
     throw InputError("could not read the image " + path.string() + ": " + e.GetDescription());
+  } catch (const std::exception& e) {
+    // ITK's readers let the standard library's exceptions out (MetaIO's
+    // std::length_error on a garbled ElementDataFile pattern): bad input too.
+    throw InputError("could not read the image " + path.string() + ": " + excerpt(e.what()));
   }
   return fromItk<T>(reader->GetOutput());
 }
