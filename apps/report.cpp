@@ -50,8 +50,12 @@ class ReportCommand : public cli::Command {
     options_.seed = common.seed;
     const pipeline::QcReport qc = pipeline::writeSubjectReport(options_);
     for (const std::string& reason : qc.reasons()) log::warn("qc " + reason);
-    if (qc.status == "fail")
-      throw ProcessingError("the result is not a plausible joint head (results.json, \"qc\"): " + qc.reasons().front());
+    if (qc.status == "fail") {
+      std::string failed;
+      for (const std::string& reason : qc.reasons())
+        if (reason.rfind("fail: ", 0) == 0) failed += (failed.empty() ? "" : "; ") + reason.substr(6);
+      throw ProcessingError("the head failed its checks (results.json, \"qc\"): " + failed);
+    }
     return 0;
   }
 

@@ -4,8 +4,9 @@
 # NIfTI, the right humeral head of the thorax DICOM series and the complete
 # left humeral head of the lossy JPEG 2000 breast-RT series. The articular
 # sphere must be that of an adult joint head (18-30 mm), on the asked side,
-# and agree with the search's own sphere. The abdomen series holds no joint
-# head: exit code 1.
+# and agree with the search's own sphere. The thorax's heads through the
+# whole run fail their checks, each for its reason. The abdomen series holds
+# no joint head: exit code 1.
 # labels: full-size
 set -euo pipefail
 D=${ARTICULA_SHARED_DATA:-}
@@ -34,6 +35,27 @@ PY
 }
 run hip "$D/ct/hip-3mm-nifti/example_ct.nii.gz" hip right
 run shoulder "$D/ct/thorax-shoulders-dicom" shoulder right
+# The thorax's humeral heads through the whole run: the right one's top
+# lies above the field of view (the report names the clipped head, a fail);
+# on the left the search takes a vertebra, on the body's midline (a fail).
+for side in right left; do
+  set +e
+  "$B/articula" run -i "$D/ct/thorax-shoulders-dicom" -o "$T/thorax-$side" --joint shoulder --side "$side" -q 2> "$T/thorax-$side.err"
+  set -e
+  python3 - "$T/thorax-$side/results.json" "$side" <<'PY'
+import json, sys
+qc, side = json.load(open(sys.argv[1]))["qc"], sys.argv[2]
+checks = {c["name"]: c for c in qc["checks"]}
+print(f"thorax {side}: qc {qc['status']}: " + "; ".join(qc.get("reasons", [])))
+assert qc["status"] == "fail", qc["status"]
+if side == "right":
+    assert checks["head_outside_volume_share"]["status"] == "fail", checks["head_outside_volume_share"]
+    assert checks["head_from_body_middle_mm"]["status"] == "pass", checks["head_from_body_middle_mm"]
+else:
+    assert checks["head_from_body_middle_mm"]["status"] == "fail", checks["head_from_body_middle_mm"]
+PY
+done
+grep -q "field of view clips the head" "$T/thorax-right.err" || fail "thorax right: the clipped head is not named: $(cat "$T/thorax-right.err")"
 if [[ -d "$D/ct/breast-rt-shoulders-j2k-dicom" ]]; then
   # Lossy JPEG 2000 and osteoporotic: the label may be a thin shell (warned).
   run breast "$D/ct/breast-rt-shoulders-j2k-dicom" shoulder left yes

@@ -129,6 +129,35 @@ TEST(HeadQc, AHeadAtTheOtherJointsDistanceFromTheMiddleWarnsAndOneOnTheMidlineFa
   EXPECT_THROW(check(pipeline::checkHead(in), "head_from_body_middle_mm"), std::runtime_error);
 }
 
+TEST(HeadQc, AHeadTheFieldOfViewClipsWarnsOrFails) {
+  // A 1 mm grid over x, y in [-40, 40] and z up to a face `cut` of the
+  // radius into the head (centre 0, radius 20, its cap facing +z, the neck -z).
+  const auto share = [](double cut) {
+    imaging::ImageGeometry grid;
+    grid.origin = Eigen::Vector3d(-40, -40, -40);
+    grid.spacing = Eigen::Vector3d::Ones();
+    grid.size = Eigen::Vector3i(81, 81, static_cast<int>(std::lround(40 + 20 * (1 - cut))) + 1);
+    pipeline::HeadQcInput in = cap(20, 80);
+    in.points.rowwise() -= in.sphere_center.transpose();
+    in.sphere_center.setZero();
+    return pipeline::headOutsideVolumeShare(grid, in.points, in.sphere_center, 20);
+  };
+  EXPECT_EQ(share(0), 0);
+  // Beyond a plane at 0.9 r lies (1 - 0.9) / 2 of a sphere; of the sphere
+  // less the neck's 45-degree cone, (0.05) / (1 - (1 - cos 45) / 2).
+  const double neck_free = 1 - (1 - std::cos(M_PI / 4)) / 2;
+  EXPECT_NEAR(share(0.1), 0.05 / neck_free, 0.01);
+  EXPECT_NEAR(share(0.25), 0.125 / neck_free, 0.01);
+  EXPECT_NEAR(share(0.5), 0.25 / neck_free, 0.01);
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.head_outside_volume_share = share(0.1);
+  EXPECT_EQ(check(pipeline::checkHead(in), "head_outside_volume_share").status, "warn");
+  in.head_outside_volume_share = share(0.5);
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "head_outside_volume_share").status, "fail");
+  EXPECT_NE(check(r, "head_outside_volume_share").reason.find("the field of view clips the head"), std::string::npos);
+}
+
 TEST(HeadQc, TwoDoubtsTogetherFail) {
   // A search centre 0.2 radii away warns; so does a spread of 5 % of the
   // radius about the sphere; together they fail. An unverified side does

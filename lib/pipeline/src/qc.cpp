@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "articula/core/error.hpp"
+#include "articula/geometry/fibonacci.hpp"
 #include "articula/imaging/edges.hpp"
 
 namespace articula::pipeline {
@@ -42,7 +43,13 @@ constexpr double kSocketFacingWarn = 0.15, kSocketFacingFail = 0.08;
 constexpr double kSocketRiseHu = 100;
 constexpr double kSocketFromMm = 0.5, kSocketToMm = 8.0, kSocketStepMm = 0.25;
 constexpr double kMidlineFailMm = 30, kHipFromMiddleWarnMm = 125, kShoulderFromMiddleWarnMm = 100;
-constexpr int kDoubtsThatFail = 2;                              // warnings of the structure's checks
+constexpr int kDoubtsThatFail = 2;
+// A head the field of view clips: the share of its sphere (the neck's 45
+// degree cone aside) beyond the outermost voxel centres. A face 10 % of the
+// radius into the head leaves about 0.06 of it outside, a quarter 0.15.
+constexpr double kNeckConeDeg = 45;
+constexpr int kOutsideDirections = 2000;
+constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;                              // warnings of the structure's checks
 
 std::string number(double v) {
   std::ostringstream s;
@@ -168,6 +175,22 @@ std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::
   return static_cast<double>(facing) / lines;
 }
 
+double headOutsideVolumeShare(const imaging::ImageGeometry& grid, const Eigen::MatrixX3d& points,
+                              const Eigen::Vector3d& center, double radius_mm) {
+  const Eigen::Vector3d axis = (points.rowwise() - center.transpose()).rowwise().normalized().colwise().mean().transpose().normalized();
+  const double neck_cos = std::cos(kNeckConeDeg * M_PI / 180);
+  const Eigen::Vector3d last = (grid.size.cast<double>() - Eigen::Vector3d::Ones());
+  int considered = 0, outside = 0;
+  for (int i = 0; i < kOutsideDirections; ++i) {
+    const Eigen::Vector3d u = geometry::fibonacciDirection(i, kOutsideDirections);
+    if (u.dot(-axis) > neck_cos) continue;
+    ++considered;
+    const Eigen::Vector3d index = grid.toIndex(center + radius_mm * u);
+    outside += (index.array() < -1e-6).any() || (index.array() > last.array() + 1e-6).any();
+  }
+  return considered > 0 ? static_cast<double>(outside) / considered : 0.0;
+}
+
 QcReport checkHead(const HeadQcInput& in) {
   const Eigen::Index n = in.points.rows();
   if (n < 4) throw InputError("head checks need at least 4 points, found " + std::to_string(n));
@@ -247,6 +270,15 @@ QcReport checkHead(const HeadQcInput& in) {
       contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the "
                          "blur across the slices";
     report.checks.push_back(contrast);
+  }
+  if (in.head_outside_volume_share) {
+    // Of what the data covers, not of the structure: a clipped head is still the head.
+    QcCheck clipped = grade("head_outside_volume_share", *in.head_outside_volume_share, kOutsideWarn, kOutsideFail,
+                            false, "the field of view clips the head: the share of its sphere (the neck aside) outside the CT is");
+    clipped.of_structure = false;
+    if (clipped.status != "pass")
+      clipped.reason += ": the points cover only the part in view, and the fitted shape extrapolates the rest";
+    report.checks.push_back(clipped);
   }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
     // Femoral heads lie 60-110 mm from the body's middle (half the distance

@@ -46,6 +46,7 @@ struct HeadQcInput {
   std::optional<double> label_depth_mm;          // the segmentation's label: the depth of its deepest voxel
   std::optional<double> socket_facing_share;     // socketFacingShare, for a hip where measurable
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
+  std::optional<double> head_outside_volume_share;  // headOutsideVolumeShare, where a CT was given
   std::string joint;                             // "hip" or "shoulder", for the head's distance from the body's middle
   std::optional<double> body_middle_x_mm;        // the search's body middle (LPS x), if it judged the side by one
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
@@ -92,6 +93,14 @@ std::optional<double> cortexContrastAcrossSlices(const imaging::Volume& ct, cons
 /// than 20 such lines lie within the grid.
 std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
                                         const Eigen::MatrixX3d& normals);
+
+/// The share of the fitted sphere's surface that lies outside the CT's
+/// field of view (beyond its outermost voxel centres), over the directions
+/// from its centre more than 45 degrees from the neck (the opposite of the
+/// articular points' mean direction): a head the field of view clips. Its
+/// points then cover only what is in view, and the fit extrapolates the rest.
+double headOutsideVolumeShare(const imaging::ImageGeometry& grid, const Eigen::MatrixX3d& points,
+                              const Eigen::Vector3d& center, double radius_mm);
 
 /// Runs every check that its inputs allow; throws InputError for fewer than 4 points.
 QcReport checkHead(const HeadQcInput& input);
