@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cstdint>
+#include <cstring>
 #include <cstdio>
 #include <algorithm>
 #include <array>
@@ -31,6 +32,24 @@ std::vector<double> numbers(const std::string& text) {
     out.push_back(v);
   }
   return out;
+}
+
+// The value representations of the elements that describe an image, as the
+// standard gives them: GDCM reads these through typed attributes and aborts
+// the process on any other ("OB OW": either).
+const char* standardVr(std::uint32_t tag) {
+  switch (tag) {
+    case 0x00080016u: case 0x00080018u: case 0x0020000Du: case 0x0020000Eu: case 0x00200052u: return "UI";
+    case 0x00080060u: case 0x00280004u: return "CS";
+    case 0x0008103Eu: case 0x00281054u: return "LO";
+    case 0x00180050u: case 0x00180088u: case 0x00200032u: case 0x00200037u: case 0x00280030u: case 0x00281050u:
+    case 0x00281051u: case 0x00281052u: case 0x00281053u: return "DS";
+    case 0x00200013u: case 0x00280008u: return "IS";
+    case 0x00280002u: case 0x00280006u: case 0x00280010u: case 0x00280011u: case 0x00280100u: case 0x00280101u:
+    case 0x00280102u: case 0x00280103u: return "US";
+    case 0x7FE00010u: return "OB OW";
+    default: return nullptr;
+  }
 }
 
 constexpr std::uint32_t kUndefinedLength = 0xFFFFFFFFu;
@@ -85,6 +104,10 @@ class Walker {
       vr = bytes(2);
       if (!(vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z'))
         throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has no value representation");
+      if (depth == 0)
+        if (const char* expected = standardVr(tag); expected && !std::strstr(expected, vr.c_str()))
+          throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has the value representation '" +
+                       vr + "', the standard's is " + expected);
       // PS3.5 7.1.2: the VRs with a 2-byte length; any other, an unknown one
       // included, has 2 reserved bytes and a 4-byte length (as GDCM reads it).
       static const char* kShort[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FL", "FD", "IS", "LO",
