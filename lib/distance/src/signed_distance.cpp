@@ -97,6 +97,11 @@ Vector3d SignedDistance::radialProjection(const Vector3d& y) const {
     (e.value < 0.0 ? lo : hi) = s;
     const double slope = e.gradient.dot(dir);
     double next = slope > 0.0 ? s - e.value / slope : std::numeric_limits<double>::quiet_NaN();
+    // Converged: a Newton step from |F| < 1e-9 lands within rounding.
+    if (next > lo && next < hi && std::fabs(e.value) < 1e-9) {
+      s = next;
+      break;
+    }
     if (!(next > lo && next < hi)) next = std::isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * s;
     if (std::fabs(next - s) <= 1e-15 * s || hi - lo <= 1e-15 * hi) {
       s = next;
@@ -169,14 +174,15 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
 
 ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) const {
   // Safeguard where Newton on the closest-point conditions fails (near points
-  // where they are singular): damped Newton on the surface itself, steps in
-  // the tangent plane projected back radially, only shorter distances
-  // accepted (it cannot diverge, and converges fast where Newton did not).
+  // where they are singular): Newton on the surface itself within a trust
+  // region, steps in the tangent plane projected back radially, only shorter
+  // distances accepted (it cannot diverge, and converges fast where Newton
+  // did not).
   const Vector3d inv_r = pose_.scale.cwiseInverse();
   const double scale = pose_.scale.maxCoeff();
   Vector3d q = radialProjection(start);
   double best = (y - q).squaredNorm();
-  double lambda = 0.0;
+  double radius = seed_spacing_ > 0.0 ? seed_spacing_ : 0.1 * scale;
   for (int i = 0; i < 200; ++i) {
     const LocalEvaluation e = evaluateLocal(*surface_, inv_r, q);
     const Vector3d n = e.gradient.normalized();
@@ -191,23 +197,23 @@ ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) c
     if (b.norm() <= 1e-13 * scale) break;
     const Eigen::Matrix2d A = T.transpose() * (Matrix3d::Identity() + mu * e.hessian) * T;
     const Eigen::Vector2d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(A, Eigen::EigenvaluesOnly).eigenvalues();
-    // Damping at least enough to make the model convex.
-    const double floor = std::max(0.0, -eig[0]) + 1e-9 * std::max(1.0, std::fabs(eig[1]));
-    lambda = std::max(lambda, floor);
+    // Damped enough for a convex model; the step cut to the trust radius.
+    const double lambda = std::max(0.0, -eig[0]) + 1e-3 * std::max(1e-3, std::fabs(eig[1]));
+    Eigen::Vector2d w = -(A + lambda * Eigen::Matrix2d::Identity()).ldlt().solve(b);
     bool accepted = false;
     for (int k = 0; k < 60; ++k) {
-      const Eigen::Vector2d w = -(A + lambda * Eigen::Matrix2d::Identity()).ldlt().solve(b);
+      if (w.norm() > radius) w *= radius / w.norm();
       if (w.norm() <= 1e-15 * scale) break;
       const Vector3d candidate = radialProjection(q + T * w);
       const double dist2 = (y - candidate).squaredNorm();
       if (dist2 < best) {
         q = candidate;
         best = dist2;
-        lambda = std::max(floor, lambda / 4.0);
+        radius = std::max(radius, 2.0 * w.norm());
         accepted = true;
         break;
       }
-      lambda = std::max(4.0 * lambda, 1e-6);
+      radius = 0.25 * w.norm();
     }
     if (!accepted) break;
   }
@@ -259,18 +265,25 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     best = descent(y, first);
   }
   // Any nearer minimum lies in the cone of a triangle whose plane is nearer
-  // than the best distance so far: those triangles are tried from their
-  // vertex nearest to y unless it is within two seed spacings of a start
-  // tried or a minimum found.
+  // than the best distance so far, within one seed spacing of a vertex closer
+  // than |d| + spacing: those triangles are tried from their vertex nearest
+  // to y unless it is within two spacings of a start tried or a minimum
+  // found. Within half a spacing of the surface every such vertex is.
   const double h = seed_spacing_;
+  if (std::fabs(best.distance) <= 0.5 * h) {
+    best.point = rotation_ * best.point + pose_.translation;
+    return best;
+  }
   std::vector<Vector3d> found{first, best.point};
   thread_local Eigen::VectorXd bound;
   bound.noalias() = planes_.col(3) - planes_.leftCols<3>() * y;
   for (Eigen::Index f = 0; f < bound.size(); ++f) {
+    const double reach = std::fabs(best.distance) + h;
     if (bound[f] >= std::fabs(best.distance)) continue;
     Eigen::Index v = triangles_(f, 0);
     for (int k = 1; k < 3; ++k)
       if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
+    if (seed_d2[v] >= reach * reach) continue;
     const Vector3d s = seeds_.row(v).transpose();
     bool near_known = false;
     for (const Vector3d& known : found)
