@@ -39,11 +39,18 @@ for e in root:
 
 def vtp_field_and_arrays(path):
     text = open(path, "rb").read().decode("latin-1")
-    space = re.search(r'<FieldData>.*?<Array type="String" Name="SPACE"[^>]*format="(\w+)"[^>]*>\s*(\S+)\s*</Array>', text, re.S)
+    space = re.search(r'<FieldData>.*?<Array type="String" Name="SPACE"([^>]*?)(/>|>\s*(\S+)\s*</Array>)', text, re.S)
     assert space, f"{path}: no SPACE field data"
-    fmt, payload = space.groups()
+    attributes, _, payload = space.groups()
+    fmt = re.search(r'format="(\w+)"', attributes).group(1)
     if fmt == "ascii":
         value = bytes(int(c) for c in payload.split()).rstrip(b"\0").decode()
+    elif fmt == "appended":  # raw bytes after "_": a length header, then the string
+        assert 'encoding="raw"' in text and "compressor=" not in text, path
+        width = 8 if 'header_type="UInt64"' in text else 4
+        start = text.index("_", text.index("<AppendedData")) + 1 + int(re.search(r'offset="(\d+)"', attributes).group(1))
+        size = int.from_bytes(text[start:start + width].encode("latin-1"), "little")
+        value = text[start + width:start + width + size].rstrip("\0")
     else:  # binary: a zlib header block, then base64 of the compressed string
         header, body = payload.split("==", 1) if "==" in payload else (payload[:24], payload[24:])
         raw = base64.b64decode(header + "==")

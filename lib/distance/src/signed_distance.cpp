@@ -1,8 +1,11 @@
 #include "articula/distance/signed_distance.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "articula/core/parallel.hpp"
@@ -43,6 +46,25 @@ void SignedDistance::buildSeeds() const {
           (seeds_.row(mesh.triangles(f, k)) - seeds_.row(mesh.triangles(f, (k + 1) % 3))).norm();
       seed_spacing_ = std::max(seed_spacing_, edge);
     }
+  // Each triangle's plane, outward. The triangles are inscribed in the convex
+  // body and close around the local origin, so the surface within the cone of
+  // a triangle seen from the origin lies beyond its plane: the plane's
+  // distance bounds the distance to that part of the surface from below.
+  // A triangle whose plane does not keep the origin inside gets no bound.
+  triangles_ = mesh.triangles;
+  planes_.resize(mesh.triangles.rows(), 4);
+  for (Eigen::Index f = 0; f < mesh.triangles.rows(); ++f) {
+    const Vector3d a = seeds_.row(mesh.triangles(f, 0)).transpose();
+    const Vector3d b = seeds_.row(mesh.triangles(f, 1)).transpose();
+    const Vector3d c = seeds_.row(mesh.triangles(f, 2)).transpose();
+    const Vector3d n = (b - a).cross(c - a);
+    const double len = n.norm();
+    const double offset = len > 0.0 ? n.dot(a) / len : 0.0;
+    if (len > 1e-12 * seed_spacing_ * seed_spacing_ && offset > 1e-9 * seed_spacing_)
+      planes_.row(f) << n.transpose() / len, offset;
+    else
+      planes_.row(f) << 0.0, 0.0, 0.0, -std::numeric_limits<double>::infinity();
+  }
 }
 
 SignedDistance::~SignedDistance() = default;
@@ -59,38 +81,35 @@ LocalEvaluation evaluateLocal(const geometry::PosedSurface& s, const Vector3d& i
 
 Vector3d SignedDistance::radialProjection(const Vector3d& y) const {
   // Every ray from the local origin (inside: F = -1) leaves the convex body
-  // exactly once: bracket the crossing and refine by Illinois regula falsi.
+  // exactly once: Newton along the ray from y's own place (near the surface
+  // where it is used), kept within a bracket of the crossing, bisection
+  // where a step would leave it.
   const Vector3d inv_r = pose_.scale.cwiseInverse();
   const Vector3d u = y.cwiseProduct(inv_r);
   const double len = u.norm();
   if (!(len > 0.0)) return Vector3d(0.0, 0.0, pose_.scale[2]);
   const Vector3d dir = u / len;
-  auto f = [&](double s) { return surface_->evaluateCanonical(s * dir, 0).value; };
-  double lo = 0.0, f_lo = -1.0, hi = 1.0, f_hi = f(hi);
-  while (f_hi <= 0.0) {
-    lo = hi;
-    f_lo = f_hi;
-    hi *= 2.0;
-    f_hi = f(hi);
-  }
-  int side = 0;
-  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
-    const double s = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-    const double fs = f(s);
-    if (fs == 0.0) return (s * dir).cwiseProduct(pose_.scale);
-    if (fs < 0.0) {
-      lo = s;
-      f_lo = fs;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    } else {
-      hi = s;
-      f_hi = fs;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
+  double lo = 0.0, hi = std::numeric_limits<double>::infinity();
+  double s = len;
+  for (int i = 0; i < 200; ++i) {
+    const geometry::Evaluation e = surface_->evaluateCanonical(s * dir, 1);
+    if (e.value == 0.0) break;
+    (e.value < 0.0 ? lo : hi) = s;
+    const double slope = e.gradient.dot(dir);
+    double next = slope > 0.0 ? s - e.value / slope : std::numeric_limits<double>::quiet_NaN();
+    // Converged: a Newton step from |F| < 1e-9 lands within rounding.
+    if (next > lo && next < hi && std::fabs(e.value) < 1e-9) {
+      s = next;
+      break;
     }
+    if (!(next > lo && next < hi)) next = std::isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * s;
+    if (std::fabs(next - s) <= 1e-15 * s || hi - lo <= 1e-15 * hi) {
+      s = next;
+      break;
+    }
+    s = next;
   }
-  return (0.5 * (lo + hi) * dir).cwiseProduct(pose_.scale);
+  return (s * dir).cwiseProduct(pose_.scale);
 }
 
 bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoint& result) const {
@@ -154,30 +173,55 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
 }
 
 ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) const {
-  // Safeguard: move along the tangent plane towards y and project back
-  // radially; accept only shorter distances (slow, but cannot diverge).
+  // Safeguard where Newton on the closest-point conditions fails (near points
+  // where they are singular): Newton on the surface itself within a trust
+  // region, steps in the tangent plane projected back radially, only shorter
+  // distances accepted (it cannot diverge, and converges fast where Newton
+  // did not).
   const Vector3d inv_r = pose_.scale.cwiseInverse();
+  const double scale = pose_.scale.maxCoeff();
   Vector3d q = radialProjection(start);
-  double best = (y - q).norm();
-  double alpha = 0.5;
-  for (int i = 0; i < 2000 && alpha > 1e-12; ++i) {
-    const Vector3d n = evaluateLocal(*surface_, inv_r, q).gradient.normalized();
-    const Vector3d v = y - q;
-    const Vector3d tangent = v - v.dot(n) * n;
-    if (tangent.norm() <= 1e-14 * pose_.scale.maxCoeff()) break;
-    const Vector3d candidate = radialProjection(q + alpha * tangent);
-    const double dist = (y - candidate).norm();
-    if (dist < best) {
-      q = candidate;
-      best = dist;
-      alpha = std::min(1.0, alpha * 1.5);
-    } else {
-      alpha *= 0.5;
+  double best = (y - q).squaredNorm();
+  double radius = seed_spacing_ > 0.0 ? seed_spacing_ : 0.1 * scale;
+  for (int i = 0; i < 200; ++i) {
+    const LocalEvaluation e = evaluateLocal(*surface_, inv_r, q);
+    const Vector3d n = e.gradient.normalized();
+    const Vector3d v = q - y;
+    // Tangent basis and the reduced problem: gradient b, Hessian A of the
+    // Lagrangian |q - y|^2 / 2 + mu F, mu from v + mu grad F = 0.
+    const Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    Eigen::Matrix<double, 3, 2> T;
+    T << t1, t2;
+    const double mu = -v.dot(e.gradient) / e.gradient.squaredNorm();
+    const Eigen::Vector2d b = T.transpose() * v;
+    if (b.norm() <= 1e-13 * scale) break;
+    const Eigen::Matrix2d A = T.transpose() * (Matrix3d::Identity() + mu * e.hessian) * T;
+    const Eigen::Vector2d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(A, Eigen::EigenvaluesOnly).eigenvalues();
+    // Damped enough for a convex model; the step cut to the trust radius.
+    const double lambda = std::max(0.0, -eig[0]) + 1e-3 * std::max(1e-3, std::fabs(eig[1]));
+    Eigen::Vector2d w = -(A + lambda * Eigen::Matrix2d::Identity()).ldlt().solve(b);
+    bool accepted = false;
+    for (int k = 0; k < 60; ++k) {
+      if (w.norm() > radius) w *= radius / w.norm();
+      if (w.norm() <= 1e-15 * scale) break;
+      const Vector3d candidate = radialProjection(q + T * w);
+      const double dist2 = (y - candidate).squaredNorm();
+      if (dist2 < best) {
+        q = candidate;
+        best = dist2;
+        radius = std::max(radius, 2.0 * w.norm());
+        accepted = true;
+        break;
+      }
+      radius = 0.25 * w.norm();
     }
+    if (!accepted) break;
   }
   ClosestPoint result;
+  // Newton polishes the minimum found (to the tolerance of its conditions).
+  if (newton(y, q, result) && std::fabs(result.distance) <= std::sqrt(best)) return result;
   result.point = q;
-  result.distance = evaluateLocal(*surface_, inv_r, y).value < 0.0 ? -best : best;
+  result.distance = evaluateLocal(*surface_, inv_r, y).value < 0.0 ? -std::sqrt(best) : std::sqrt(best);
   return result;
 }
 
@@ -220,17 +264,30 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
   } else {
     best = descent(y, first);
   }
-  // Any nearer local minimum lies within one seed spacing of some seed that
-  // is closer than |d| + spacing to y: try those far from minima already found.
+  // Any nearer minimum lies in the cone of a triangle whose plane is nearer
+  // than the best distance so far, within one seed spacing of a vertex closer
+  // than |d| + spacing: those triangles are tried from their vertex nearest
+  // to y unless it is within two spacings of a start tried or a minimum
+  // found. Within half a spacing of the surface every such vertex is.
   const double h = seed_spacing_;
-  std::vector<Vector3d> found{best.point};
-  const double reach = std::fabs(best.distance) + h;
-  for (Eigen::Index i = 0; i < seeds_.rows(); ++i) {
-    if (seed_d2[i] >= reach * reach) continue;
-    const Vector3d s = seeds_.row(i).transpose();
+  if (std::fabs(best.distance) <= 0.5 * h) {
+    best.point = rotation_ * best.point + pose_.translation;
+    return best;
+  }
+  std::vector<Vector3d> found{first, best.point};
+  thread_local Eigen::VectorXd bound;
+  bound.noalias() = planes_.col(3) - planes_.leftCols<3>() * y;
+  for (Eigen::Index f = 0; f < bound.size(); ++f) {
+    const double reach = std::fabs(best.distance) + h;
+    if (bound[f] >= std::fabs(best.distance)) continue;
+    Eigen::Index v = triangles_(f, 0);
+    for (int k = 1; k < 3; ++k)
+      if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
+    if (seed_d2[v] >= reach * reach) continue;
+    const Vector3d s = seeds_.row(v).transpose();
     bool near_known = false;
-    for (const Vector3d& f : found)
-      if ((s - f).squaredNorm() < 4.0 * h * h) near_known = true;
+    for (const Vector3d& known : found)
+      if ((s - known).squaredNorm() < 4.0 * h * h) near_known = true;
     if (near_known) continue;
     const ClosestPoint c = solve(s);
     found.push_back(s);

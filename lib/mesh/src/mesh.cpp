@@ -477,8 +477,9 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
 
 namespace {
 
-// Writes `poly` as .vtp, .stl or .ply (by extension) atomically, with its frame stated.
-void writePolyData(const fs::path& path, vtkPolyData* poly, bool overwrite) {
+// Writes `poly` as .vtp, .stl or .ply (by extension) atomically, with its
+// frame stated; a .vtp zlib-compressed, or raw when not `compress`.
+void writePolyData(const fs::path& path, vtkPolyData* poly, bool overwrite, bool compress = true) {
   if (!overwrite && fs::exists(path)) throw UsageError("refusing to overwrite " + path.string() + " (use --force)");
   const std::string ext = extensionOf(path);
   const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
@@ -498,6 +499,11 @@ void writePolyData(const fs::path& path, vtkPolyData* poly, bool overwrite) {
     w->SetInputData(poly);
     w->SetFileName(temp.c_str());
     w->SetDataModeToBinary();
+    if (!compress) {
+      w->SetCompressorTypeToNone();
+      w->SetDataModeToAppended();
+      w->EncodeAppendedDataOff();
+    }
     ok = w->Write();
   } else if (ext == ".stl") {
     vtkNew<vtkSTLWriter> w;
@@ -550,7 +556,9 @@ void writePointValues(const fs::path& path, const Eigen::MatrixX3d& points, cons
   poly->SetPoints(vtk_points);
   poly->SetVerts(vertices);
   poly->GetPointData()->SetScalars(array);
-  writePolyData(path, poly, overwrite);
+  // Raw, not zlib: compressing took 60 % of articula errors' time at 10^6
+  // points (five clouds), for files a quarter smaller.
+  writePolyData(path, poly, overwrite, false);
 }
 
 TriangleMesh readMesh(const fs::path& path) {

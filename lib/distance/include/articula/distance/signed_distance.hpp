@@ -6,9 +6,10 @@
 // Sphere: closed form. Ellipsoid: Eberly's robust root bracketing.
 // Superellipsoid, ovoid, superovoid: Newton on the closest-point conditions
 // q - x + mu grad F(q) = 0, F(q) = 0, started from the nearest point of a
-// precomputed surface sample; every other sample that could lie in a nearer
-// basin (deep interior points, points near the medial axis) is tried too,
-// and a projected descent on the surface takes over where Newton fails.
+// precomputed surface sample; inside, the sample's triangles whose planes
+// are nearer than the best distance so far (the surface in their cone lies
+// beyond them) are tried too (deep interior points, points near the medial
+// axis), and a projected descent on the surface takes over where Newton fails.
 #include <memory>
 #include <vector>
 
@@ -79,6 +80,8 @@ class SignedDistance {
   // Built on first use, so that warm-started evaluation (fitting) skips it.
   mutable Eigen::MatrixX3d seeds_;  // surface sample in the rotated frame (mm)
   mutable double seed_spacing_ = 0.0;
+  mutable Eigen::MatrixX3i triangles_;   // the sample's triangles (seed indices)
+  mutable Eigen::MatrixX4d planes_;     // their planes: outward unit normal, offset (-inf: no bound)
 };
 
 /// Signed distances of `points` (#P x 3) to `shape`: convenience over SignedDistance.

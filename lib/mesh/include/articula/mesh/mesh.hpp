@@ -107,6 +107,7 @@ void writeMesh(const std::filesystem::path& path, const TriangleMesh& mesh, bool
 /// Points with one value each (say signed distances) as a .vtp point cloud
 /// whose active scalars are the values under `name`: 3D Slicer and ParaView
 /// colour it by the values themselves (a PLY would hand them RGB only).
+/// Written uncompressed (raw appended data), for speed on large clouds.
 void writePointValues(const std::filesystem::path& path, const Eigen::MatrixX3d& points, const std::string& name,
                       const Eigen::VectorXd& values, bool overwrite = true);
 /// Reads .vtp, .stl, .ply, .vtk or .obj; computes normals if the file has none.
