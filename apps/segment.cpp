@@ -109,6 +109,7 @@ class SegmentCommand : public cli::Command {
         {"side_check", s.side_check},
         {"body_middle_x_mm", s.body_middle_x_mm ? nlohmann::json(*s.body_middle_x_mm) : nlohmann::json(nullptr)},
         {"body_middle_from", s.body_middle_from},
+        {"head_found_by", s.head_found_by},
         {"seed_mm", vec(s.seed_mm)},
         {"head_center_mm", vec(s.head_center_mm)},
         {"search_radius_mm", s.search_radius_mm},

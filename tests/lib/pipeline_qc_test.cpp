@@ -158,6 +158,18 @@ TEST(HeadQc, AHeadTheFieldOfViewClipsWarnsOrFails) {
   EXPECT_NE(check(r, "head_outside_volume_share").reason.find("the field of view clips the head"), std::string::npos);
 }
 
+TEST(HeadQc, AHeadTheSearchTookByItsFallbackWarns) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.found_by_edges = true;
+  EXPECT_EQ(pipeline::checkHead(in).status, "pass");
+  in.found_by_edges = false;
+  in.side_verified = false;  // neither is a doubt about the structure: together they only warn
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(r.status, "warn");
+  EXPECT_EQ(check(r, "head_found_by_edges").status, "warn");
+  EXPECT_NE(check(r, "head_found_by_edges").reason.find("its fallback"), std::string::npos);
+}
+
 TEST(HeadQc, TwoDoubtsTogetherFail) {
   // A search centre 0.2 radii away warns; so does a spread of 5 % of the
   // radius about the sphere; together they fail. An unverified side does

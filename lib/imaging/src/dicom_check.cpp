@@ -1,18 +1,19 @@
 #include "dicom_check.hpp"
 
-#include <cctype>
-#include <cstdint>
-#include <cstring>
-#include <cstdio>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <map>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
 
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
@@ -127,6 +128,7 @@ class Walker {
       if (depth == 0 && header && tag == kPixelData) header->pixel_data_bytes = DicomSliceHeader::kEncapsulated;
       items(depth + 1, tag, start);
     } else if (depth == 0 && header && capture(tag, length, start)) {
+      // noted in the slice header
     } else {
       if (value && length <= 256) {
         need(length, tag, start);

@@ -296,6 +296,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     summary.edge_coverage = head_found.coverage;
     summary.edge_rms_mm = head_found.rms_mm;
   }
+  summary.head_found_by = measured ? "edges" : options.seed_point ? "seed point" : "surface voxels";
   summary.seed_mm = center;
 
   // 3. Work on a box around the head that also holds the socket.

@@ -306,6 +306,18 @@ QcReport checkHead(const HeadQcInput& in) {
     }
     report.checks.push_back(lateral);
   }
+  if (in.found_by_edges) {
+    QcCheck edges;
+    edges.name = "head_found_by_edges";
+    edges.of_structure = false;
+    edges.value = *in.found_by_edges ? 1 : 0;
+    edges.rule = "warn when the search found no sphere through the head's bone edges and took it by its facing surface voxels";
+    edges.status = *in.found_by_edges ? "pass" : "warn";
+    if (!*in.found_by_edges)
+      edges.reason = "the head search found no spherical bone edge along its rays and took the head by the surface "
+                     "voxels facing a centre (its fallback): check the head on the slices";
+    report.checks.push_back(edges);
+  }
   if (in.side_verified) {
     QcCheck side;
     side.name = "side_verified";

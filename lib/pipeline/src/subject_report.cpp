@@ -117,6 +117,7 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
         in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());
         in.search_radius_mm = seg.value("search_radius_mm", 0.0);
         if (seg.contains("side_check")) in.side_verified = seg.value("side_check", "") != "not verified";
+        if (seg.contains("head_found_by")) in.found_by_edges = seg.value("head_found_by", "") == "edges";
         if (seg.contains("body_middle_x_mm") && seg.at("body_middle_x_mm").is_number())
           in.body_middle_x_mm = seg.at("body_middle_x_mm").get<double>();
       }

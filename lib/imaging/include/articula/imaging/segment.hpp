@@ -50,6 +50,8 @@ struct SegmentSummary {
   std::string side_check;                   // automatic: how the side was established, or "not verified"
   std::optional<double> body_middle_x_mm;   // automatic: the body's middle (LPS x) the side was judged by
   std::string body_middle_from;             // "outline" or "field of view" (a wide one), with body_middle_x_mm
+  std::string head_found_by;                // "edges" (a sphere through bone edges along rays), "surface voxels"
+                                            // (automatic, no such sphere: the voxels facing a centre), "seed point"
   Eigen::Vector3d seed_mm = Eigen::Vector3d::Zero();
   // Automatic search: the centre of the head's sphere; with a seed point:
   // the deepest point of the label.

@@ -41,6 +41,7 @@ struct HeadQcInput {
   std::optional<Eigen::Vector3d> search_center;  // the segmentation's head, if it searched
   double search_radius_mm = 0;
   std::optional<bool> side_verified;             // the search's side check, if it searched
+  std::optional<bool> found_by_edges;            // the search's head: a sphere through bone edges, else its fallback
   std::optional<PointsOnCtEdge> ct_edges;        // where the CT's bone edge is about the points, if a CT was given
   double ct_voxel_mm = 0;                        // the CT's largest spacing: its edge checks apply up to 2 mm
   std::optional<double> label_depth_mm;          // the segmentation's label: the depth of its deepest voxel
