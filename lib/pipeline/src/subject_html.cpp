@@ -26,9 +26,15 @@ std::string fixed(double v, int digits) {
   return buffer;
 }
 
-// "22.72 ± 0.19" (the 95 % interval's half width) or the value alone.
+// "22.72 ± 0.19" (the 95 % interval's half width), the value alone, or the
+// value marked as one the points do not determine (in the model's
+// not_identifiable: its name is the key without its unit).
 std::string withInterval(const json& model, const std::string& key, int digits) {
   const double v = numberAt(member(model, "parameters"), key);
+  const std::string name = key.substr(0, key.find('_'));
+  for (const auto& open : member(model, "not_identifiable"))
+    if (open.is_string() && open.get<std::string>() == name)
+      return fixed(v, digits) + " <span class=\"note\">(not determined)</span>";
   const double se = numberAt(member(model, "standard_errors"), key);
   return fixed(v, digits) + (std::isfinite(se) ? " &plusmn; " + fixed(1.96 * se, digits) : "");
 }
