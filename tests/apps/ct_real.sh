@@ -5,7 +5,8 @@
 # left humeral head of the lossy JPEG 2000 breast-RT series. The articular
 # sphere must be that of an adult joint head (18-30 mm), on the asked side,
 # and agree with the search's own sphere. The thorax's heads through the
-# whole run fail their checks, each for its reason. The abdomen series holds
+# whole run fail their checks, each for its reason; the 3 mm hip's left head
+# is found beside its screws, the metal named. The abdomen series holds
 # no joint head: exit code 1.
 # labels: full-size
 set -euo pipefail
@@ -63,6 +64,19 @@ else:
 PY
 done
 grep -q "field of view clips the head" "$T/thorax-right.err" || fail "thorax right: the clipped head is not named: $(cat "$T/thorax-right.err")"
+# The 3 mm hip's left femur carries screws: the head is found, the metal named.
+set +e
+"$B/articula" run -i "$D/ct/hip-3mm-nifti/example_ct.nii.gz" -o "$T/hip-left" --joint hip --side left -q 2> "$T/hip-left.err"
+set -e
+python3 - "$T/hip-left/results.json" <<'PY'
+import json, sys
+results = json.load(open(sys.argv[1]))
+checks = {c["name"]: c for c in results["qc"]["checks"]}
+print(f"hip left: qc {results['qc']['status']}, metal near the head {checks['metal_near_head_mm3']['value']:.0f} mm^3")
+assert checks["metal_near_head_mm3"]["status"] == "warn", checks["metal_near_head_mm3"]
+assert 18 <= results["models"][0]["parameters"]["a_mm"] <= 30, results["models"][0]["parameters"]
+assert results["models"][0]["parameters"]["t1_mm"] > 0, "the left side is +x in LPS"
+PY
 if [[ -d "$D/ct/breast-rt-shoulders-j2k-dicom" ]]; then
   # Lossy JPEG 2000 and osteoporotic: the label may be a thin shell (warned).
   run breast "$D/ct/breast-rt-shoulders-j2k-dicom" shoulder left yes

@@ -170,6 +170,30 @@ TEST(HeadQc, AHeadTheSearchTookByItsFallbackWarns) {
   EXPECT_NE(check(r, "head_found_by_edges").reason.find("its fallback"), std::string::npos);
 }
 
+TEST(HeadQc, MetalNearTheHeadWarns) {
+  // A 1 mm grid of bone (1,800 HU, below the metal threshold) with a screw,
+  // 3 x 3 x 20 voxels of 3,000 HU, 30 mm from the head's centre, and another
+  // 60 mm away (beyond two radii of a 20 mm head).
+  imaging::Volume ct;
+  ct.geometry.size = Eigen::Vector3i(100, 100, 40);
+  ct.geometry.origin = Eigen::Vector3d(-50, -50, -20);
+  ct.voxels.assign(static_cast<size_t>(ct.geometry.voxelCount()), 1800.0f);
+  for (int x : {30, 60})
+    for (int k = 10; k < 30; ++k)
+      for (int j = 49; j < 52; ++j)
+        for (int i = 49 + x; i < 52 + x && i < 100; ++i) ct.at(i, j, k) = 3000.0f;
+  const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  EXPECT_DOUBLE_EQ(pipeline::metalNearHead(ct, centre, 20), 3 * 3 * 20);  // the near screw whole, the far one not
+  EXPECT_DOUBLE_EQ(pipeline::metalNearHead(ct, centre, 10), 0);
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.metal_near_head_mm3 = pipeline::metalNearHead(ct, centre, 20);
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "metal_near_head_mm3").status, "warn");
+  EXPECT_EQ(r.status, "warn");
+  in.metal_near_head_mm3 = 0;
+  EXPECT_EQ(check(pipeline::checkHead(in), "metal_near_head_mm3").status, "pass");
+}
+
 TEST(HeadQc, TwoDoubtsTogetherFail) {
   // A search centre 0.2 radii away warns; so does a spread of 5 % of the
   // radius about the sphere; together they fail. An unverified side does

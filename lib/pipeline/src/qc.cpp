@@ -49,7 +49,11 @@ constexpr int kDoubtsThatFail = 2;
 // radius into the head leaves about 0.06 of it outside, a quarter 0.15.
 constexpr double kNeckConeDeg = 45;
 constexpr int kOutsideDirections = 2000;
-constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;                              // warnings of the structure's checks
+constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
+// Metal near the head: voxels above 2,500 HU (cortical bone reaches about
+// 2,000) within two radii of its centre, warned from 100 mm^3 (a screw of
+// 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
+constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;                              // warnings of the structure's checks
 
 std::string number(double v) {
   std::ostringstream s;
@@ -191,6 +195,24 @@ double headOutsideVolumeShare(const imaging::ImageGeometry& grid, const Eigen::M
   return considered > 0 ? static_cast<double>(outside) / considered : 0.0;
 }
 
+double metalNearHead(const imaging::Volume& ct, const Eigen::Vector3d& center, double radius_mm) {
+  const imaging::ImageGeometry& g = ct.geometry;
+  const double reach = kMetalReachRadii * radius_mm;
+  // The index box holding the ball (the grid may be rotated: its corners' indices bound it).
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d x = center + reach * Eigen::Vector3d(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1);
+    lo = lo.cwiseMin(g.toIndex(x));
+    hi = hi.cwiseMax(g.toIndex(x));
+  }
+  long long metal = 0;
+  for (int k = std::max(0, int(std::floor(lo.z()))); k <= std::min(g.size[2] - 1, int(std::ceil(hi.z()))); ++k)
+    for (int j = std::max(0, int(std::floor(lo.y()))); j <= std::min(g.size[1] - 1, int(std::ceil(hi.y()))); ++j)
+      for (int i = std::max(0, int(std::floor(lo.x()))); i <= std::min(g.size[0] - 1, int(std::ceil(hi.x()))); ++i)
+        if (ct.at(i, j, k) > kMetalHu && (g.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm() <= reach) ++metal;
+  return static_cast<double>(metal) * g.spacing.prod();
+}
+
 QcReport checkHead(const HeadQcInput& in) {
   const Eigen::Index n = in.points.rows();
   if (n < 4) throw InputError("head checks need at least 4 points, found " + std::to_string(n));
@@ -279,6 +301,15 @@ QcReport checkHead(const HeadQcInput& in) {
     if (clipped.status != "pass")
       clipped.reason += ": the points cover only the part in view, and the fitted shape extrapolates the rest";
     report.checks.push_back(clipped);
+  }
+  if (in.metal_near_head_mm3) {
+    QcCheck metal = grade("metal_near_head_mm3", *in.metal_near_head_mm3, kMetalWarnMm3, std::nullopt, false,
+                          "metal near the head: the volume (mm^3) above " + number(kMetalHu) + " HU within " +
+                              number(kMetalReachRadii) + " radii of its centre is");
+    metal.of_structure = false;
+    if (metal.status == "warn")
+      metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
+    report.checks.push_back(metal);
   }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
     // Femoral heads lie 60-110 mm from the body's middle (half the distance

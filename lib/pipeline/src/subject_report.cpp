@@ -106,7 +106,10 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
   in.sphere_center = sphere->center;
   in.sphere_radius_mm = sphere->radii[0];
   in.joint = joint;
-  if (ct) in.head_outside_volume_share = headOutsideVolumeShare(ct->geometry, in.points, in.sphere_center, in.sphere_radius_mm);
+  if (ct) {
+    in.head_outside_volume_share = headOutsideVolumeShare(ct->geometry, in.points, in.sphere_center, in.sphere_radius_mm);
+    in.metal_near_head_mm3 = metalNearHead(*ct, in.sphere_center, in.sphere_radius_mm);
+  }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);

@@ -48,6 +48,7 @@ struct HeadQcInput {
   std::optional<double> socket_facing_share;     // socketFacingShare, for a hip where measurable
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   std::optional<double> head_outside_volume_share;  // headOutsideVolumeShare, where a CT was given
+  std::optional<double> metal_near_head_mm3;     // metalNearHead, where a CT was given
   std::string joint;                             // "hip" or "shoulder", for the head's distance from the body's middle
   std::optional<double> body_middle_x_mm;        // the search's body middle (LPS x), if it judged the side by one
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
@@ -102,6 +103,11 @@ std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::
 /// points then cover only what is in view, and the fit extrapolates the rest.
 double headOutsideVolumeShare(const imaging::ImageGeometry& grid, const Eigen::MatrixX3d& points,
                               const Eigen::Vector3d& center, double radius_mm);
+
+/// The volume (mm^3) of the voxels above 2,500 HU (metal: screws, stems,
+/// wires; cortical bone stays below) within twice the head's radius of its
+/// centre: streaks and dark bands from metal can bias the head's surface.
+double metalNearHead(const imaging::Volume& ct, const Eigen::Vector3d& center, double radius_mm);
 
 /// Runs every check that its inputs allow; throws InputError for fewer than 4 points.
 QcReport checkHead(const HeadQcInput& input);
