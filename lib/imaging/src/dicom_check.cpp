@@ -40,6 +40,9 @@ std::vector<double> numbers(const std::string& text) {
 // the process on any other ("OB OW": either).
 const char* standardVr(std::uint32_t tag) {
   switch (tag) {
+    case 0x00020000u: return "UL";
+    case 0x00020001u: return "OB";
+    case 0x00020002u: case 0x00020003u: case 0x00020010u: case 0x00020012u: return "UI";
     case 0x00080016u: case 0x00080018u: case 0x0020000Du: case 0x0020000Eu: case 0x00200052u: return "UI";
     case 0x00080060u: case 0x00280004u: return "CS";
     case 0x0008103Eu: case 0x00281054u: return "LO";
@@ -105,12 +108,17 @@ class Walker {
       vr = bytes(2);
       if (!(vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z'))
         throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has no value representation");
+      // GDCM guesses at a VR it does not know (and at the encoding with it),
+      // and aborted the process on such a file: only the standard's are read.
+      static const std::string kKnown = "AE AS AT CS DA DS DT FL FD IS LO LT OB OD OF OL OV OW PN SH SL SQ SS ST SV TM UC UI UL UN UR US UT UV";
+      if (kKnown.find(vr) == std::string::npos)  // two capitals match only a whole entry
+        throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has the unknown value representation '" + vr + "'");
       if (depth == 0)
         if (const char* expected = standardVr(tag); expected && !std::strstr(expected, vr.c_str()))
           throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has the value representation '" +
                        vr + "', the standard's is " + expected);
-      // PS3.5 7.1.2: the VRs with a 2-byte length; any other, an unknown one
-      // included, has 2 reserved bytes and a 4-byte length (as GDCM reads it).
+      // PS3.5 7.1.2: the VRs with a 2-byte length; any other has 2 reserved
+      // bytes and a 4-byte length.
       static const char* kShort[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FL", "FD", "IS", "LO",
                                      "LT", "PN", "SH", "SL", "SS", "ST", "TM", "UI", "UL", "US"};
       bool long_form = true;

@@ -165,8 +165,15 @@ void checkMetaImage(const fs::path& path) {
     data.offset = in.tellg();
   } else if (where.find(' ') == std::string::npos && where != "LIST" && where.find('%') == std::string::npos) {
     data.file = fs::path(where).is_absolute() ? fs::path(where) : path.parent_path() / where;
+  } else if (where == "LIST") {
+    return;  // a list of slice files: ITK reads and checks them
   } else {
-    return;  // a list or pattern of slice files: ITK reads and checks them
+    // A printf pattern with its first, last and step ("slice%03d.raw 1 40
+    // 1"): MetaIO divided by a zero step and formatted garbled patterns past
+    // their buffer. Such a series is rare; one file serves as well.
+    throw InputError(path.string() + ": ElementDataFile = '" + excerpt(where, 60) +
+                     "' names a pattern of slice files, which is not read here; expected LOCAL, LIST or one data "
+                     "file (write the image as one .mha or .nrrd)");
   }
   if (data.compressed) {
     // ITK's MetaImage reader inflates exactly CompressedDataSize bytes: without
