@@ -9,6 +9,7 @@
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/imaging/io.hpp"
+#include "articula/imaging/label_mask.hpp"
 #include "articula/imaging/segment.hpp"
 
 namespace articula::apps {
@@ -48,6 +49,10 @@ class SegmentCommand : public cli::Command {
     app.add_option("--roi", roi_, "Box xmin,ymin,zmin,xmax,ymax,zmax in LPS mm")->delimiter(',')->expected(6);
     app.add_option("--min-radius", options_.min_head_radius_mm, "Smallest plausible head radius (mm)")->capture_default_str();
     app.add_option("--max-radius", options_.max_head_radius_mm, "Largest plausible head radius (mm)")->capture_default_str();
+    app.add_option("--label", label_,
+                   "A label map in the CT's grid (a femur or humerus mask from another tool): the head is cut from its bone");
+    app.add_option("--label-value", label_value_, "The label's value of the bone (default: every non-zero voxel)")
+        ->check(CLI::Range(1, 65535));
   }
   int run(const cli::CommonOptions& common) override {
     imaging::limitImagingThreads(common.threadCount());
@@ -59,7 +64,7 @@ class SegmentCommand : public cli::Command {
       options_.roi_max = Eigen::Vector3d(roi_[3], roi_[4], roi_[5]);
     }
     options_.validate();
-    refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_});
+    refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, label_});
     checkOutputTarget(output_);
     cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
@@ -67,7 +72,12 @@ class SegmentCommand : public cli::Command {
     read.series_uid = series_uid_;
     imaging::ReadReport report;
     const std::shared_ptr<const imaging::Volume> shared_ct = imaging::readSharedVolume(input_, read, &report);
-    const imaging::Volume& ct = *shared_ct;
+    std::optional<imaging::Volume> labelled_bone;
+    if (!label_.empty()) {
+      labelled_bone = imaging::keepLabelledBone(*shared_ct, label_, label_value_ ? std::optional<int>(label_value_) : std::nullopt);
+      options_.one_bone = true;
+    }
+    const imaging::Volume& ct = labelled_bone ? *labelled_bone : *shared_ct;
     for (const auto& w : report.warnings) log::warn(w);
     const auto& g = ct.geometry;
     log::info("read " + input_.string() + ": " + std::to_string(g.size[0]) + "x" + std::to_string(g.size[1]) + "x" +
@@ -88,6 +98,11 @@ class SegmentCommand : public cli::Command {
     if (options_.roi_min) params["roi_mm"] = {vec(*options_.roi_min), vec(*options_.roi_max)};
     std::vector<std::filesystem::path> inputs;
     if (std::filesystem::is_regular_file(input_)) inputs.push_back(input_);
+    if (!label_.empty()) {
+      params["label"] = label_.string();
+      if (label_value_) params["label_value"] = label_value_;
+      inputs.push_back(label_);
+    }
     nlohmann::json series = nlohmann::json::array();
     for (const auto& si : report.series)
       series.push_back({{"uid", si.uid}, {"modality", si.modality}, {"description", si.description}, {"files", si.files}});
@@ -106,6 +121,7 @@ class SegmentCommand : public cli::Command {
         {"gantry_tilt_deg", report.gantry_tilt_deg},
         {"hu_window", {options_.hu_min, options_.hu_max}},
         {"seed_source", s.seed_source},
+        {"label", label_.empty() ? nlohmann::json(nullptr) : nlohmann::json(label_.string())},
         {"side_check", s.side_check},
         {"body_middle_x_mm", s.body_middle_x_mm ? nlohmann::json(*s.body_middle_x_mm) : nlohmann::json(nullptr)},
         {"body_middle_from", s.body_middle_from},
@@ -126,7 +142,8 @@ class SegmentCommand : public cli::Command {
   }
 
  private:
-  std::filesystem::path input_, output_;
+  std::filesystem::path input_, output_, label_;
+  int label_value_ = 0;
   std::string joint_ = "hip", side_ = "right", series_uid_;
   std::vector<double> seed_point_, roi_;
   imaging::SegmentOptions options_;

@@ -435,7 +435,9 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   const std::optional<double> body_mid = bodyMidline(coarse);
   const bool wide = fieldWidthMm(g) >= kBothSidesWidthMm;
   const double mid_x = body_mid ? *body_mid : g.toPhysical((g.size.cast<double>() - Eigen::Vector3d::Ones()) / 2.0)[0];
-  const bool side_by_position = body_mid.has_value() || wide;
+  // One labelled bone: the label chose the side, and the bone's own outline
+  // is no body's.
+  const bool side_by_position = !options.one_bone && (body_mid.has_value() || wide);
   const double midline_margin = side_by_position ? effectiveMidlineMargin(g, options) : 0.0;
   // A head lies on its side of the middle and clear of it: structures on
   // the midline (a sacrum, a symphysis) can look round. Within the margin a
@@ -451,7 +453,8 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   };
   if (side_by_position) side.middle_x_mm = mid_x;
   side.middle_from_outline = body_mid.has_value();
-  side.how = body_mid ? "left or right of the body's middle (x = " + std::to_string(*body_mid) + " mm, from its outline)"
+  side.how = options.one_bone ? "the label's bone"
+             : body_mid       ? "left or right of the body's middle (x = " + std::to_string(*body_mid) + " mm, from its outline)"
                : wide   ? "left or right of the field of view's middle"
                         : "";
   struct Peak { Eigen::Vector3d x; double votes; };
@@ -511,7 +514,7 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   // In a narrow field without the body's outline, the socket says which
   // side the joint is: a joint of the other side is refused, not analysed.
   const auto sideConfirmed = [&](const HeadCandidate& c) {
-    if (side_by_position) return true;
+    if (side_by_position || options.one_bone) return true;  // a labelled bone shows no socket
     const std::optional<Side> by_socket = sideBySocket(volume, c, options);
     const std::string joint_side = by_socket == Side::Right ? "right" : "left";
     if (!by_socket) {

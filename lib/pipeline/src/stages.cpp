@@ -15,7 +15,7 @@ const std::vector<StageDescription>& stages() {
   static const std::vector<StageDescription> table = {
       {"segment",
        "Segment the joint head from a CT (label image)",
-       {"seed-point", "series-uid", "hu-min", "hu-max", "roi", "level-set"},
+       {"seed-point", "series-uid", "hu-min", "hu-max", "roi", "level-set", "label", "label-value"},
        {"CT"},
        {"label.nii.gz"},
        {"-i", "{CT}", "-o", "{folder}/label.nii.gz", "--joint", "{joint}", "--side", "{side}"},

@@ -26,6 +26,7 @@ struct SegmentOptions {
   double hu_max = 3000.0;
   std::optional<Eigen::Vector3d> roi_min, roi_max;  // LPS mm box; both or neither
   std::optional<Eigen::Vector3d> seed_point;        // LPS mm, inside the head; else automatic
+  bool one_bone = false;  // the CT holds one bone only (keepLabelledBone): its side is the label's, not judged by position
   Joint joint = Joint::Hip;
   Side side = Side::Right;                          // patient side (LPS: right is -x)
   double min_head_radius_mm = 15.0;                 // plausible joint heads
