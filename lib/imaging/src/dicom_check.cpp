@@ -216,6 +216,9 @@ class Walker {
       case 0x00280011u: count = &header->columns; break;
       case 0x00280100u: count = &header->bits_allocated; break;
       case 0x00280002u: count = &header->samples_per_pixel; break;
+      case 0x00280101u: count = &header->bits_stored; break;
+      case 0x00280102u: count = &header->high_bit; break;
+      case 0x00280103u: count = &header->pixel_representation; break;
       case kPixelData:
         header->pixel_data_bytes = length;
         skip(length, tag, start);
@@ -462,6 +465,20 @@ void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector
   double pixel_bytes = 0;
   for (size_t k = 0; k < files.size(); ++k) {
     const DicomSliceHeader& h = headers[k];
+    // The pixel description as a CT stores it: GDCM aborts the process on
+    // some others (more bits stored than allocated).
+    const bool bits_ok = (h.bits_allocated == 8 || h.bits_allocated == 16 || h.bits_allocated == 32) &&
+                         (h.bits_stored == -1 || (h.bits_stored >= 1 && h.bits_stored <= h.bits_allocated)) &&
+                         (h.high_bit == -1 || (h.high_bit >= 0 && h.high_bit < h.bits_allocated)) &&
+                         (h.pixel_representation == -1 || h.pixel_representation == 0 || h.pixel_representation == 1) &&
+                         (h.samples_per_pixel == -1 || h.samples_per_pixel == 1);
+    if (!bits_ok)
+      throw InputError(series + ": " + where(k) + " describes its pixels as " + std::to_string(h.samples_per_pixel) +
+                       " sample(s) of " + std::to_string(h.bits_allocated) + " bits allocated, " +
+                       std::to_string(h.bits_stored) + " stored, high bit " + std::to_string(h.high_bit) +
+                       ", representation " + std::to_string(h.pixel_representation) +
+                       "; expected one sample of 8, 16 or 32 bits allocated, at most as many stored, signed (1) or "
+                       "unsigned (0): a CT's grey values");
     if (h.rows != first.rows || h.columns != first.columns)
       throw InputError(series + ": " + where(k) + " is " + std::to_string(h.rows) + " x " + std::to_string(h.columns) +
                        " pixels (rows x columns), the first slice " + std::to_string(first.rows) + " x " +

@@ -27,6 +27,7 @@ struct DicomSliceHeader {
   std::string position, orientation, pixel_spacing, rescale_slope, frames;  // DS/IS text
   std::string series_uid, modality, description;
   long rows = -1, columns = -1, bits_allocated = -1, samples_per_pixel = -1;
+  long bits_stored = -1, high_bit = -1, pixel_representation = -1;
   static constexpr std::int64_t kEncapsulated = -2;
   std::int64_t pixel_data_bytes = -1;  // -1: no Pixel Data; kEncapsulated: compressed fragments
 };

@@ -147,10 +147,24 @@ void checkMetaImage(const fs::path& path) {
   if (fields.count("NDims") && fields["NDims"] != "3")
     throw InputError(path.string() + ": the MetaImage header says NDims = " + excerpt(fields["NDims"]) +
                      "; expected NDims = 3 (a 3-D volume)");
-  if (!fields.count("ElementDataFile") || !fields.count("DimSize") || !fields.count("ElementType")) return;
+  if (!fields.count("ElementDataFile") || !fields.count("DimSize") || !fields.count("ElementType")) return;  // ITK says why
+  const std::string where = fields["ElementDataFile"];
+  if (where != "LOCAL" && where != "LIST" && (where.find(' ') != std::string::npos || where.find('%') != std::string::npos))
+    // A printf pattern with its first, last and step ("slice%03d.raw 1 40
+    // 1"): MetaIO divided by a zero step and formatted garbled patterns past
+    // their buffer. Such a series is rare; one file serves as well.
+    throw InputError(path.string() + ": ElementDataFile = '" + excerpt(where, 60) +
+                     "' names a pattern of slice files, which is not read here; expected LOCAL, LIST or one data "
+                     "file (write the image as one .mha or .nrrd)");
+  // MetaIO reads what it can of a garbled size or type: both are judged here.
   const auto type = kBytes.find(fields["ElementType"]);
   const std::vector<unsigned long long> sizes = sizesOf(fields["DimSize"]);
-  if (type == kBytes.end() || sizes.empty()) return;  // ITK says why
+  if (sizes.size() != 3)
+    throw InputError(path.string() + ": the MetaImage header says DimSize = '" + excerpt(fields["DimSize"], 60) +
+                     "'; expected three whole numbers");
+  if (type == kBytes.end())
+    throw InputError(path.string() + ": the MetaImage header says ElementType = '" + excerpt(fields["ElementType"], 60) +
+                     "'; expected a scalar type such as MET_SHORT or MET_FLOAT");
   DataLayout data;
   unsigned long long channels = 1;
   if (fields.count("ElementNumberOfChannels")) {
@@ -159,21 +173,13 @@ void checkMetaImage(const fs::path& path) {
   }
   data.expected = product(sizes, type->second * channels);
   data.compressed = lower(fields["CompressedData"]) == "true";
-  const std::string where = fields["ElementDataFile"];
   if (where == "LOCAL") {
     data.file = path;
     data.offset = in.tellg();
-  } else if (where.find(' ') == std::string::npos && where != "LIST" && where.find('%') == std::string::npos) {
-    data.file = fs::path(where).is_absolute() ? fs::path(where) : path.parent_path() / where;
   } else if (where == "LIST") {
     return;  // a list of slice files: ITK reads and checks them
   } else {
-    // A printf pattern with its first, last and step ("slice%03d.raw 1 40
-    // 1"): MetaIO divided by a zero step and formatted garbled patterns past
-    // their buffer. Such a series is rare; one file serves as well.
-    throw InputError(path.string() + ": ElementDataFile = '" + excerpt(where, 60) +
-                     "' names a pattern of slice files, which is not read here; expected LOCAL, LIST or one data "
-                     "file (write the image as one .mha or .nrrd)");
+    data.file = fs::path(where).is_absolute() ? fs::path(where) : path.parent_path() / where;
   }
   if (data.compressed) {
     // ITK's MetaImage reader inflates exactly CompressedDataSize bytes: without
