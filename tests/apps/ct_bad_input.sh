@@ -85,6 +85,19 @@ expect 3 "missing slice?); the folder holds 1 file(s) that could not be read as 
 rm -rf "$T/s" && mkdir "$T/s" && cp "$T/p/dicom/slice_003"[012].dcm "$T/s/"
 expect 3 "expected a 3-D volume of at least 4 voxels along each axis in $T/s, found size 95x75x3" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
+# A series of bare data sets (no preamble and meta header): left out, with what to do.
+rm -rf "$T/s" && mkdir "$T/s" && python3 - "$T/p/dicom" "$T/s" <<'PY'
+import glob, os, sys
+for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.dcm"))):
+    b = open(f, "rb").read()
+    at = 132
+    while int.from_bytes(b[at:at + 2], "little") == 0x0002:  # the meta header, explicit VR: (gggg,eeee) VR length
+        vr = b[at + 4:at + 6]
+        at += (12 + int.from_bytes(b[at + 8:at + 12], "little")) if vr in (b"OB", b"UN") else (8 + int.from_bytes(b[at + 6:at + 8], "little"))
+    open(os.path.join(sys.argv[2], os.path.basename(f)), "wb").write(b[at:])
+PY
+expect 3 "found 64 bare DICOM data set(s) without the preamble and meta header .* rewrite them as DICOM files" -- \
+  "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
 # A bare data set (no preamble) that GDCM would take for DICOM and abort on: refused by name.
 slices && printf '\x02\x00\x00\x00\x72\x00\x00\x00\x02\x00' > "$T/s/bare.dcm"
 expect 3 "bare.dcm: no DICOM preamble, and " -- "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"

@@ -387,6 +387,7 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
       if (const std::string problem = codestreamProblem(in, syntax, walk.fragments); !problem.empty()) throw Broken(problem);
     result.kind = DicomFileKind::Complete;
     result.header.read = true;
+    result.header.bare = !preamble;
   } catch (const Broken& e) {
     result.kind = DicomFileKind::Damaged;
     result.problem = (preamble ? "" : "no DICOM preamble, and ") + std::string(e.what());
@@ -582,7 +583,11 @@ DicomFolder scanDicomFolder(const std::filesystem::path& folder) {
       if (++out.damaged_count <= 5) out.damaged.push_back(excerpt(file_name) + ": " + check.problem);
       continue;
     }
-    if (!check.header.read || check.header.pixel_data_bytes == -1) {
+    // A bare data set (no preamble and meta header, as Part 10 requires) is
+    // walked but left out: GDCM guesses at its encoding, and aborted the
+    // process on several whose walk passed.
+    if (!check.header.read || check.header.bare || check.header.pixel_data_bytes == -1) {
+      out.bare_files += check.header.read && check.header.bare;
       out.other_files.push_back(file_name);
       continue;
     }

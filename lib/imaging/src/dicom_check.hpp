@@ -24,6 +24,7 @@ enum class DicomFileKind {
 /// as written (empty text or -1 where the element is absent).
 struct DicomSliceHeader {
   bool read = false;  // the data set was walked to its end
+  bool bare = false;  // a data set without the preamble and meta header of a DICOM file
   std::string position, orientation, pixel_spacing, rescale_slope, frames;  // DS/IS text
   std::string series_uid, modality, description;
   long rows = -1, columns = -1, bits_allocated = -1, samples_per_pixel = -1;
@@ -53,7 +54,8 @@ struct DicomFolder {
     std::vector<DicomSliceHeader> headers;
   };
   std::vector<Series> series;
-  std::vector<std::string> other_files;  // names: no DICOM, or DICOM without pixel data
+  std::vector<std::string> other_files;  // names: no DICOM, DICOM without pixel data, or bare data sets
+  int bare_files = 0;                    // data sets without the preamble and meta header (left out)
   std::vector<std::string> damaged;      // "name: problem", the first five
   int damaged_count = 0;
 };

@@ -473,6 +473,10 @@ DicomFolder scanSeries(const fs::path& folder) {
                      std::to_string(scan.damaged_count) + " damaged (cut short or corrupted; replace or remove them):" +
                      list + (scan.damaged_count > 5 ? "\n  ..." : ""));
   }
+  if (scan.series.empty() && scan.bare_files > 0)
+    throw InputError("expected DICOM files in " + folder.string() + ", found " + std::to_string(scan.bare_files) +
+                     " bare DICOM data set(s) without the preamble and meta header a DICOM file begins with; rewrite "
+                     "them as DICOM files (gdcmconv IN OUT, or dcmconv +F IN OUT) and give that folder");
   if (scan.series.empty())
     throw InputError("expected DICOM files in " + folder.string() + ", found none (no readable DICOM series)" +
                      dicomFoldersBelow(folder));
