@@ -231,7 +231,12 @@ class Walker {
       while (!text->empty() && (text->back() == ' ' || text->back() == '\0')) text->pop_back();
       return true;
     }
-    if (count && length == 2) {
+    if (count) {
+      // One 16-bit number: GDCM reads another length its own way (and
+      // aborted on the samples per pixel it made of one).
+      if (length != 2)
+        throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " holds " +
+                     std::to_string(length) + " bytes; expected one 16-bit number (2 bytes)");
       *count = static_cast<long>(read16());
       return true;
     }
