@@ -383,7 +383,16 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
     }
     // Zero bytes after the last element are padding some writers leave; GDCM
     // stops there too, but in a big-endian data set it aborts on them.
-    while (!walk.atEnd() && !walk.restIsZero()) walk.element(0);
+    // PS3.5 7.1: each element once, in ascending order. GDCM keeps the first
+    // of two alike (the walk noted the last), and aborted on what it kept.
+    for (std::uint32_t last = 0; !walk.atEnd() && !walk.restIsZero();) {
+      const std::uint64_t at = walk.position();
+      const std::uint32_t tag = walk.element(0);
+      if (tag <= last)
+        throw Broken("element " + tagName(tag) + " at byte " + std::to_string(at) + " follows " + tagName(last) +
+                     ": a data set holds each element once, in ascending order");
+      last = tag;
+    }
     if (!walk.atEnd() && walk.big_endian)
       throw Broken("zero bytes follow the last element of a big-endian data set, from byte " +
                    std::to_string(walk.position()));

@@ -3,6 +3,7 @@
 // (buffers are both i-fastest, so a straight copy), and ITK file I/O.
 // Include after articula/imaging/image.hpp (system Eigen before ITK's bundled one).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -10,8 +11,10 @@
 
 #include <itkImage.h>
 #include <itkImageFileReader.h>
-#include <itkImageIOFactory.h>
 #include <itkImageFileWriter.h>
+#include <itkMetaImageIO.h>
+#include <itkNiftiImageIO.h>
+#include <itkNrrdImageIO.h>
 
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
@@ -78,9 +81,24 @@ Image<T> fromItk(const itk::Image<U, 3>* image) {
 /// Other formats: no-op.
 void checkNiftiFile(const std::filesystem::path& path);
 
+/// The reader of an image file chosen by its extension (null for another).
+/// Not ITK's factory: it asks every reader whether it can read the file, and
+/// GDCM's, asked of a damaged .nrrd, parsed it and aborted the process.
+inline itk::ImageIOBase::Pointer imageIoFor(const std::filesystem::path& path) {
+  std::string name = path.filename().string();
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const auto ends = [&name](const std::string& ext) {
+    return name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  if (ends(".nii") || ends(".nii.gz")) return itk::NiftiImageIO::New().GetPointer();
+  if (ends(".nrrd") || ends(".nhdr")) return itk::NrrdImageIO::New().GetPointer();
+  if (ends(".mha") || ends(".mhd")) return itk::MetaImageIO::New().GetPointer();
+  return nullptr;
+}
+
 /// The pixel type an image file stores (UNKNOWNCOMPONENTTYPE when ITK has no reader for it).
 inline itk::IOComponentEnum storedComponentType(const std::filesystem::path& path) {
-  auto io = itk::ImageIOFactory::CreateImageIO(path.string().c_str(), itk::CommonEnums::IOFileMode::ReadMode);
+  auto io = imageIoFor(path);
   if (!io) return itk::IOComponentEnum::UNKNOWNCOMPONENTTYPE;
   try {
     io->SetFileName(path.string());
@@ -97,7 +115,8 @@ Image<T> readImageFile(const std::filesystem::path& path) {
   checkImageDataLength(path);
   // What the file holds, before ITK reads it as 3-D (it would silently take
   // the first volume of a 4-D image and the first component of a vector).
-  if (auto io = itk::ImageIOFactory::CreateImageIO(path.string().c_str(), itk::CommonEnums::IOFileMode::ReadMode)) {
+  const itk::ImageIOBase::Pointer io = imageIoFor(path);
+  if (io) {
     try {
       io->SetFileName(path.string());
       io->ReadImageInformation();
@@ -121,6 +140,7 @@ Image<T> readImageFile(const std::filesystem::path& path) {
   }
   auto reader = itk::ImageFileReader<itk::Image<T, 3>>::New();
   reader->SetFileName(path.string());
+  if (io) reader->SetImageIO(io);
   try {
     reader->Update();
   } catch (const itk::ExceptionObject& e) {
