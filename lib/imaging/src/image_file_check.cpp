@@ -124,6 +124,14 @@ void checkMetaImage(const fs::path& path) {
   std::map<std::string, std::string> fields;
   std::string line;
   while (std::getline(in, line) && in.tellg() < (1 << 20)) {
+    // MetaIO reads each line as a C string: a NUL ends a key early ("Element
+    // DataFile\0\0 =" was its data file's line), and no header holds control
+    // characters.
+    for (const char c : line)
+      if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r')
+        throw InputError(path.string() + ": the MetaImage header's line '" + excerpt(trimmed(line), 60) +
+                         "' holds a control character (byte " + std::to_string(static_cast<unsigned char>(c)) +
+                         "); expected text lines up to ElementDataFile");
     const auto eq = line.find('=');
     // MetaIO takes the words of a line without '=' for a key and reads on
     // into the next lines for its value: such a header spun it for ever.
