@@ -141,6 +141,13 @@ void checkMetaImage(const fs::path& path) {
                        "' has no '='; expected 'Key = Value' lines up to ElementDataFile");
     }
     const std::string key = trimmed(line.substr(0, eq));
+    // MetaIO copies keys and values into fixed buffers (a 300-character key
+    // overran one): its fields are short names and values.
+    const bool named = !key.empty() && key.size() <= 64 &&
+                       std::all_of(key.begin(), key.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+    if (!named || line.size() > 1024)
+      throw InputError(path.string() + ": the MetaImage header's line '" + excerpt(trimmed(line), 60) +
+                       "' is no field (a name of letters and digits, a value, 1,024 characters at most)");
     // MetaIO reads the fields in order, each sized by the NDims it has read
     // so far: a second NDims, or a second of any field, would make it read
     // other numbers than those judged here.
