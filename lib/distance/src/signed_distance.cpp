@@ -27,6 +27,7 @@ struct LocalEvaluation {
   Matrix3d hessian;
 };
 
+constexpr Eigen::Index kGroup = 6;  // triangles per bounding run
 bool isQuadric(ShapeModel m) { return m == ShapeModel::Sphere || m == ShapeModel::Ellipsoid; }
 }  // namespace
 
@@ -64,6 +65,24 @@ void SignedDistance::buildSeeds() const {
       planes_.row(f) << n.transpose() / len, offset;
     else
       planes_.row(f) << 0.0, 0.0, 0.0, -std::numeric_limits<double>::infinity();
+  }
+  // The sample's triangles come in strips, so consecutive ones are close:
+  // o_f - n_f.y >= min o - n.y - max |n_f - n| |y| bounds a run's planes.
+  const Eigen::Index groups = (planes_.rows() + kGroup - 1) / kGroup;
+  groups_.resize(groups, 5);
+  for (Eigen::Index g = 0; g < groups; ++g) {
+    const Eigen::Index begin = g * kGroup, end = std::min(begin + kGroup, planes_.rows());
+    Vector3d n = Vector3d::Zero();
+    double offset = std::numeric_limits<double>::infinity();
+    for (Eigen::Index f = begin; f < end; ++f) {
+      n += planes_.block<1, 3>(f, 0).transpose();
+      offset = std::min(offset, planes_(f, 3));
+    }
+    n = n.norm() > 0.0 ? Vector3d(n.normalized()) : Vector3d::UnitZ();
+    double spread = 0.0;
+    for (Eigen::Index f = begin; f < end; ++f)
+      spread = std::max(spread, (planes_.block<1, 3>(f, 0).transpose() - n).norm());
+    groups_.row(g) << n.transpose(), spread, offset;
   }
 }
 
@@ -183,6 +202,7 @@ ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) c
   Vector3d q = radialProjection(start);
   double best = (y - q).squaredNorm();
   double radius = seed_spacing_ > 0.0 ? seed_spacing_ : 0.1 * scale;
+  double handover = 1e-4;
   for (int i = 0; i < 200; ++i) {
     const LocalEvaluation e = evaluateLocal(*surface_, inv_r, q);
     const Vector3d n = e.gradient.normalized();
@@ -195,6 +215,13 @@ ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) c
     const double mu = -v.dot(e.gradient) / e.gradient.squaredNorm();
     const Eigen::Vector2d b = T.transpose() * v;
     if (b.norm() <= 1e-13 * scale) break;
+    // Close to a minimum Newton converges in a step or two, where the descent
+    // would creep down to rounding level; if it lands elsewhere, go on.
+    if (b.norm() <= handover * scale) {
+      ClosestPoint polished;
+      if (newton(y, q, polished) && std::fabs(polished.distance) <= std::sqrt(best)) return polished;
+      handover *= 1e-3;
+    }
     const Eigen::Matrix2d A = T.transpose() * (Matrix3d::Identity() + mu * e.hessian) * T;
     const Eigen::Vector2d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(A, Eigen::EigenvaluesOnly).eigenvalues();
     // Damped enough for a convex model; the step cut to the trust radius.
@@ -275,11 +302,18 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     return best;
   }
   std::vector<Vector3d> found{first, best.point};
-  thread_local Eigen::VectorXd bound;
-  bound.noalias() = planes_.col(3) - planes_.leftCols<3>() * y;
-  for (Eigen::Index f = 0; f < bound.size(); ++f) {
+  const double y_norm = y.norm();
+  for (Eigen::Index f = 0; f < planes_.rows(); ++f) {
+    if (f % kGroup == 0) {
+      const Eigen::Index g = f / kGroup;
+      if (groups_(g, 4) - groups_.block<1, 3>(g, 0).dot(y.transpose()) - groups_(g, 3) * y_norm >=
+          std::fabs(best.distance)) {
+        f += kGroup - 1;
+        continue;
+      }
+    }
     const double reach = std::fabs(best.distance) + h;
-    if (bound[f] >= std::fabs(best.distance)) continue;
+    if (planes_(f, 3) - planes_.block<1, 3>(f, 0).dot(y.transpose()) >= std::fabs(best.distance)) continue;
     Eigen::Index v = triangles_(f, 0);
     for (int k = 1; k < 3; ++k)
       if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
