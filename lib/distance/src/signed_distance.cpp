@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <Eigen/Eigenvalues>
@@ -159,9 +160,12 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
     if (J.determinant() != 0.0) step = J.inverse() * -r;
     if (!step.allFinite()) step = J.partialPivLu().solve(-r);
     if (!step.allFinite()) return false;
+    // A step that must be cut below 1/16 heads for a singular point of the
+    // conditions, where the merit stalls short of zero: the caller's descent
+    // is cheaper than halving on.
     double alpha = 1.0;
     bool accepted = false;
-    for (int k = 0; k < 30; ++k, alpha *= 0.5) {
+    for (int k = 0; k < 5; ++k, alpha *= 0.5) {
       const Vector3d q_new = q + alpha * step.head<3>();
       const double mu_new = mu + alpha * step[3];
       const LocalEvaluation e_new = evaluateLocal(*surface_, inv_r, q_new);
@@ -303,6 +307,14 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
   }
   std::vector<Vector3d> found{first, best.point};
   const double y_norm = y.norm();
+  // A vertex once considered is near a start or minimum from then on: each is
+  // compared with those found once, not for each of its triangles.
+  thread_local std::vector<std::uint32_t> seen;
+  thread_local std::uint32_t stamp = 0;
+  if (seen.size() < static_cast<size_t>(seeds_.rows()) || ++stamp == 0) {
+    seen.assign(std::max(seen.size(), static_cast<size_t>(seeds_.rows())), 0);
+    stamp = 1;
+  }
   for (Eigen::Index f = 0; f < planes_.rows(); ++f) {
     if (f % kGroup == 0) {
       const Eigen::Index g = f / kGroup;
@@ -317,7 +329,8 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     Eigen::Index v = triangles_(f, 0);
     for (int k = 1; k < 3; ++k)
       if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
-    if (seed_d2[v] >= reach * reach) continue;
+    if (seed_d2[v] >= reach * reach || seen[v] == stamp) continue;
+    seen[v] = stamp;
     const Vector3d s = seeds_.row(v).transpose();
     bool near_known = false;
     for (const Vector3d& known : found)
