@@ -306,7 +306,9 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     return best;
   }
   std::vector<Vector3d> found{first, best.point};
-  const double y_norm = y.norm();
+  thread_local Eigen::VectorXd group_bound;
+  group_bound.noalias() = groups_.col(4) - groups_.leftCols<3>() * y;
+  group_bound.array() -= y.norm() * groups_.col(3).array();
   // A vertex once considered is near a start or minimum from then on: each is
   // compared with those found once, not for each of its triangles.
   thread_local std::vector<std::uint32_t> seen;
@@ -315,31 +317,26 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     seen.assign(std::max(seen.size(), static_cast<size_t>(seeds_.rows())), 0);
     stamp = 1;
   }
-  for (Eigen::Index f = 0; f < planes_.rows(); ++f) {
-    if (f % kGroup == 0) {
-      const Eigen::Index g = f / kGroup;
-      if (groups_(g, 4) - groups_.block<1, 3>(g, 0).dot(y.transpose()) - groups_(g, 3) * y_norm >=
-          std::fabs(best.distance)) {
-        f += kGroup - 1;
-        continue;
-      }
+  for (Eigen::Index g = 0; g < group_bound.size(); ++g) {
+    if (group_bound[g] >= std::fabs(best.distance)) continue;
+    for (Eigen::Index f = g * kGroup; f < std::min((g + 1) * kGroup, planes_.rows()); ++f) {
+      const double reach = std::fabs(best.distance) + h;
+      if (planes_(f, 3) - planes_.block<1, 3>(f, 0).dot(y.transpose()) >= std::fabs(best.distance)) continue;
+      Eigen::Index v = triangles_(f, 0);
+      for (int k = 1; k < 3; ++k)
+        if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
+      if (seed_d2[v] >= reach * reach || seen[v] == stamp) continue;
+      seen[v] = stamp;
+      const Vector3d s = seeds_.row(v).transpose();
+      bool near_known = false;
+      for (const Vector3d& known : found)
+        if ((s - known).squaredNorm() < 4.0 * h * h) near_known = true;
+      if (near_known) continue;
+      const ClosestPoint c = solve(s);
+      found.push_back(s);
+      found.push_back(c.point);
+      if (std::fabs(c.distance) < std::fabs(best.distance)) best = c;
     }
-    const double reach = std::fabs(best.distance) + h;
-    if (planes_(f, 3) - planes_.block<1, 3>(f, 0).dot(y.transpose()) >= std::fabs(best.distance)) continue;
-    Eigen::Index v = triangles_(f, 0);
-    for (int k = 1; k < 3; ++k)
-      if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
-    if (seed_d2[v] >= reach * reach || seen[v] == stamp) continue;
-    seen[v] = stamp;
-    const Vector3d s = seeds_.row(v).transpose();
-    bool near_known = false;
-    for (const Vector3d& known : found)
-      if ((s - known).squaredNorm() < 4.0 * h * h) near_known = true;
-    if (near_known) continue;
-    const ClosestPoint c = solve(s);
-    found.push_back(s);
-    found.push_back(c.point);
-    if (std::fabs(c.distance) < std::fabs(best.distance)) best = c;
   }
   best.point = rotation_ * best.point + pose_.translation;
   return best;
