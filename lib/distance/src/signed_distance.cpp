@@ -305,7 +305,8 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     best.point = rotation_ * best.point + pose_.translation;
     return best;
   }
-  std::vector<Vector3d> found{first, best.point};
+  thread_local std::vector<Vector3d> found;  // reused: no allocation per point
+  found.assign({first, best.point});
   thread_local Eigen::VectorXd group_bound;
   group_bound.noalias() = groups_.col(4) - groups_.leftCols<3>() * y;
   group_bound.array() -= y.norm() * groups_.col(3).array();
