@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <Eigen/Eigenvalues>
@@ -27,6 +28,7 @@ struct LocalEvaluation {
   Matrix3d hessian;
 };
 
+constexpr Eigen::Index kGroup = 6;  // triangles per bounding run
 bool isQuadric(ShapeModel m) { return m == ShapeModel::Sphere || m == ShapeModel::Ellipsoid; }
 }  // namespace
 
@@ -64,6 +66,24 @@ void SignedDistance::buildSeeds() const {
       planes_.row(f) << n.transpose() / len, offset;
     else
       planes_.row(f) << 0.0, 0.0, 0.0, -std::numeric_limits<double>::infinity();
+  }
+  // The sample's triangles come in strips, so consecutive ones are close:
+  // o_f - n_f.y >= min o - n.y - max |n_f - n| |y| bounds a run's planes.
+  const Eigen::Index groups = (planes_.rows() + kGroup - 1) / kGroup;
+  groups_.resize(groups, 5);
+  for (Eigen::Index g = 0; g < groups; ++g) {
+    const Eigen::Index begin = g * kGroup, end = std::min(begin + kGroup, planes_.rows());
+    Vector3d n = Vector3d::Zero();
+    double offset = std::numeric_limits<double>::infinity();
+    for (Eigen::Index f = begin; f < end; ++f) {
+      n += planes_.block<1, 3>(f, 0).transpose();
+      offset = std::min(offset, planes_(f, 3));
+    }
+    n = n.norm() > 0.0 ? Vector3d(n.normalized()) : Vector3d::UnitZ();
+    double spread = 0.0;
+    for (Eigen::Index f = begin; f < end; ++f)
+      spread = std::max(spread, (planes_.block<1, 3>(f, 0).transpose() - n).norm());
+    groups_.row(g) << n.transpose(), spread, offset;
   }
 }
 
@@ -140,9 +160,12 @@ bool SignedDistance::newton(const Vector3d& y, const Vector3d& start, ClosestPoi
     if (J.determinant() != 0.0) step = J.inverse() * -r;
     if (!step.allFinite()) step = J.partialPivLu().solve(-r);
     if (!step.allFinite()) return false;
+    // A step that must be cut below 1/16 heads for a singular point of the
+    // conditions, where the merit stalls short of zero: the caller's descent
+    // is cheaper than halving on.
     double alpha = 1.0;
     bool accepted = false;
-    for (int k = 0; k < 30; ++k, alpha *= 0.5) {
+    for (int k = 0; k < 5; ++k, alpha *= 0.5) {
       const Vector3d q_new = q + alpha * step.head<3>();
       const double mu_new = mu + alpha * step[3];
       const LocalEvaluation e_new = evaluateLocal(*surface_, inv_r, q_new);
@@ -183,6 +206,7 @@ ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) c
   Vector3d q = radialProjection(start);
   double best = (y - q).squaredNorm();
   double radius = seed_spacing_ > 0.0 ? seed_spacing_ : 0.1 * scale;
+  double handover = 1e-4;
   for (int i = 0; i < 200; ++i) {
     const LocalEvaluation e = evaluateLocal(*surface_, inv_r, q);
     const Vector3d n = e.gradient.normalized();
@@ -195,6 +219,13 @@ ClosestPoint SignedDistance::descent(const Vector3d& y, const Vector3d& start) c
     const double mu = -v.dot(e.gradient) / e.gradient.squaredNorm();
     const Eigen::Vector2d b = T.transpose() * v;
     if (b.norm() <= 1e-13 * scale) break;
+    // Close to a minimum Newton converges in a step or two, where the descent
+    // would creep down to rounding level; if it lands elsewhere, go on.
+    if (b.norm() <= handover * scale) {
+      ClosestPoint polished;
+      if (newton(y, q, polished) && std::fabs(polished.distance) <= std::sqrt(best)) return polished;
+      handover *= 1e-3;
+    }
     const Eigen::Matrix2d A = T.transpose() * (Matrix3d::Identity() + mu * e.hessian) * T;
     const Eigen::Vector2d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(A, Eigen::EigenvaluesOnly).eigenvalues();
     // Damped enough for a convex model; the step cut to the trust radius.
@@ -274,25 +305,39 @@ ClosestPoint SignedDistance::closest(const Vector3d& x) const {
     best.point = rotation_ * best.point + pose_.translation;
     return best;
   }
-  std::vector<Vector3d> found{first, best.point};
-  thread_local Eigen::VectorXd bound;
-  bound.noalias() = planes_.col(3) - planes_.leftCols<3>() * y;
-  for (Eigen::Index f = 0; f < bound.size(); ++f) {
-    const double reach = std::fabs(best.distance) + h;
-    if (bound[f] >= std::fabs(best.distance)) continue;
-    Eigen::Index v = triangles_(f, 0);
-    for (int k = 1; k < 3; ++k)
-      if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
-    if (seed_d2[v] >= reach * reach) continue;
-    const Vector3d s = seeds_.row(v).transpose();
-    bool near_known = false;
-    for (const Vector3d& known : found)
-      if ((s - known).squaredNorm() < 4.0 * h * h) near_known = true;
-    if (near_known) continue;
-    const ClosestPoint c = solve(s);
-    found.push_back(s);
-    found.push_back(c.point);
-    if (std::fabs(c.distance) < std::fabs(best.distance)) best = c;
+  thread_local std::vector<Vector3d> found;  // reused: no allocation per point
+  found.assign({first, best.point});
+  thread_local Eigen::VectorXd group_bound;
+  group_bound.noalias() = groups_.col(4) - groups_.leftCols<3>() * y;
+  group_bound.array() -= y.norm() * groups_.col(3).array();
+  // A vertex once considered is near a start or minimum from then on: each is
+  // compared with those found once, not for each of its triangles.
+  thread_local std::vector<std::uint32_t> seen;
+  thread_local std::uint32_t stamp = 0;
+  if (seen.size() < static_cast<size_t>(seeds_.rows()) || ++stamp == 0) {
+    seen.assign(std::max(seen.size(), static_cast<size_t>(seeds_.rows())), 0);
+    stamp = 1;
+  }
+  for (Eigen::Index g = 0; g < group_bound.size(); ++g) {
+    if (group_bound[g] >= std::fabs(best.distance)) continue;
+    for (Eigen::Index f = g * kGroup; f < std::min((g + 1) * kGroup, planes_.rows()); ++f) {
+      const double reach = std::fabs(best.distance) + h;
+      if (planes_(f, 3) - planes_.block<1, 3>(f, 0).dot(y.transpose()) >= std::fabs(best.distance)) continue;
+      Eigen::Index v = triangles_(f, 0);
+      for (int k = 1; k < 3; ++k)
+        if (seed_d2[triangles_(f, k)] < seed_d2[v]) v = triangles_(f, k);
+      if (seed_d2[v] >= reach * reach || seen[v] == stamp) continue;
+      seen[v] = stamp;
+      const Vector3d s = seeds_.row(v).transpose();
+      bool near_known = false;
+      for (const Vector3d& known : found)
+        if ((s - known).squaredNorm() < 4.0 * h * h) near_known = true;
+      if (near_known) continue;
+      const ClosestPoint c = solve(s);
+      found.push_back(s);
+      found.push_back(c.point);
+      if (std::fabs(c.distance) < std::fabs(best.distance)) best = c;
+    }
   }
   best.point = rotation_ * best.point + pose_.translation;
   return best;

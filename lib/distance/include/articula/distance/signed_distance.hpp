@@ -82,6 +82,9 @@ class SignedDistance {
   mutable double seed_spacing_ = 0.0;
   mutable Eigen::MatrixX3i triangles_;   // the sample's triangles (seed indices)
   mutable Eigen::MatrixX4d planes_;     // their planes: outward unit normal, offset (-inf: no bound)
+  // Runs of consecutive triangles: mean normal, largest normal deviation,
+  // smallest offset; a lower bound for all their planes at once.
+  mutable Eigen::Matrix<double, Eigen::Dynamic, 5> groups_;
 };
 
 /// Signed distances of `points` (#P x 3) to `shape`: convenience over SignedDistance.
