@@ -356,14 +356,30 @@ TEST(HeadQc, AShellLabelOffTheCtsEdgesFailsAtCoarseVoxels) {
 /// over 150 HU), a 2 mm joint gap and a 4 mm acetabular wall (600 HU) over
 /// the head's upper half, in 40 HU soft tissue; blurred radially (0.8 mm),
 /// on voxels of `spacing`.
-imaging::Volume hipWithSocket(const Eigen::Vector3d& centre, const Eigen::Vector3d& spacing) {
+imaging::Volume hipWithSocket(const Eigen::Vector3d& centre, const Eigen::Vector3d& spacing, double gap = 2) {
   constexpr double s = 0.8;
-  return volumeAbout(centre, 34, spacing, [](const Eigen::Vector3d& d) {
+  return volumeAbout(centre, 34, spacing, [gap](const Eigen::Vector3d& d) {
     const double r = d.norm();
     const double head = 660 * Phi((22 - r) / s) - 550 * Phi((21 - r) / s);
-    const double socket = d.z() > -0.2 * r ? 560 * (Phi((r - 24) / s) - Phi((r - 28) / s)) : 0.0;
+    const double socket = d.z() > -0.2 * r ? 560 * (Phi((r - 22 - gap) / s) - Phi((r - 26 - gap) / s)) : 0.0;
     return 40 + head + socket;
   });
+}
+
+TEST(HeadQc, ANarrowedJointSpaceWarns) {
+  // The joint space read across the gap follows the gap; a gap of 0.8 mm
+  // (a narrowed, arthritic joint) warns.
+  pipeline::HeadQcInput head = cap(22, 80);
+  for (const double gap : {0.8, 2.0, 4.0}) {
+    const auto facing = pipeline::socketFacing(hipWithSocket(head.sphere_center, Eigen::Vector3d(0.7, 0.7, 1.5), gap),
+                                               head.points, head.normals);
+    ASSERT_TRUE(facing && facing->joint_space_mm) << gap;
+    // Under the blur (0.8 mm) the two edges merge: the reading stops near 1.5 mm.
+    if (gap >= 2) EXPECT_NEAR(*facing->joint_space_mm, gap, 0.6) << gap;
+    else EXPECT_LT(*facing->joint_space_mm, 2.0) << gap;
+    head.joint_space_mm = facing->joint_space_mm;
+    EXPECT_EQ(check(pipeline::checkHead(head), "joint_space_mm").status, gap < 1.5 ? "warn" : "pass") << gap;
+  }
 }
 
 TEST(HeadQc, ASocketsOuterSurfaceFailsOnTheSocketItFaces) {
@@ -373,23 +389,25 @@ TEST(HeadQc, ASocketsOuterSurfaceFailsOnTheSocketItFaces) {
   const Eigen::Vector3d voxels(1.5, 1.5, 3.0);
   pipeline::HeadQcInput head = cap(22, 80);
   const imaging::Volume ct = hipWithSocket(head.sphere_center, voxels);
-  head.socket_facing_share = pipeline::socketFacingShare(ct, head.points, head.normals);
-  ASSERT_TRUE(head.socket_facing_share);
+  const auto facing = pipeline::socketFacing(ct, head.points, head.normals);
+  ASSERT_TRUE(facing);
+  head.socket_facing_share = facing->share;
   EXPECT_GT(*head.socket_facing_share, 0.8);
   EXPECT_EQ(pipeline::checkHead(head).status, "pass");
 
   pipeline::HeadQcInput outer = cap(28, 80);
   outer.sphere_center = head.sphere_center;
-  outer.socket_facing_share = pipeline::socketFacingShare(ct, outer.points, outer.normals);
-  ASSERT_TRUE(outer.socket_facing_share);
+  const auto outer_facing = pipeline::socketFacing(ct, outer.points, outer.normals);
+  ASSERT_TRUE(outer_facing);
+  outer.socket_facing_share = outer_facing->share;
   EXPECT_LT(*outer.socket_facing_share, 0.05);
   const pipeline::QcReport r = pipeline::checkHead(outer);
   EXPECT_EQ(check(r, "socket_facing_share").status, "fail");
   EXPECT_EQ(r.status, "fail");
 
   // Voxels of 3 mm within the slices resolve no gap: not measured.
-  EXPECT_FALSE(pipeline::socketFacingShare(hipWithSocket(head.sphere_center, Eigen::Vector3d::Constant(3.0)),
-                                           head.points, head.normals));
+  EXPECT_FALSE(pipeline::socketFacing(hipWithSocket(head.sphere_center, Eigen::Vector3d::Constant(3.0)),
+                                      head.points, head.normals));
 }
 
 TEST(HeadQc, TooFewPointsAreRefused) {

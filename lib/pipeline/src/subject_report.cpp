@@ -98,7 +98,11 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
     in.ct_voxel_mm = ct->geometry.spacing.maxCoeff();
     in.cortex_contrast_across_slices = cortexContrastAcrossSlices(*ct, in.points, in.normals);
     // A humeral head's glenoid is small and shallow: most of its cap faces none.
-    if (joint == "hip") in.socket_facing_share = socketFacingShare(*ct, in.points, in.normals);
+    if (joint == "hip")
+      if (const auto socket = socketFacing(*ct, in.points, in.normals)) {
+        in.socket_facing_share = socket->share;
+        in.joint_space_mm = socket->joint_space_mm;
+      }
   }
   const auto sphere =
       std::find_if(shapes.begin(), shapes.end(), [](const auto& s) { return s.model == geometry::ShapeModel::Sphere; });

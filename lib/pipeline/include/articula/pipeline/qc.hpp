@@ -45,7 +45,8 @@ struct HeadQcInput {
   std::optional<PointsOnCtEdge> ct_edges;        // where the CT's bone edge is about the points, if a CT was given
   double ct_voxel_mm = 0;                        // the CT's largest spacing: its edge checks apply up to 2 mm
   std::optional<double> label_depth_mm;          // the segmentation's label: the depth of its deepest voxel
-  std::optional<double> socket_facing_share;     // socketFacingShare, for a hip where measurable
+  std::optional<double> socket_facing_share;     // socketFacing's share, for a hip where measurable
+  std::optional<double> joint_space_mm;          // socketFacing's joint space, for a hip where measurable
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   std::optional<double> head_outside_volume_share;  // headOutsideVolumeShare, where a CT was given
   std::optional<double> metal_near_head_mm3;     // metalNearHead, where a CT was given
@@ -93,8 +94,12 @@ std::optional<double> cortexContrastAcrossSlices(const imaging::Volume& ct, cons
 /// the point: a socket across a joint gap of up to about 5 mm. Empty where
 /// the voxels within a slice exceed 2 mm (a gap is not resolved) or fewer
 /// than 20 such lines lie within the grid.
-std::optional<double> socketFacingShare(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
-                                        const Eigen::MatrixX3d& normals);
+struct SocketFacing {
+  double share = 0;                      // of the lines within the grid, those that meet a socket
+  std::optional<double> joint_space_mm;  // the median distance, on those, from the point to the socket's half rise (20 lines at least)
+};
+std::optional<SocketFacing> socketFacing(const imaging::Volume& ct, const Eigen::MatrixX3d& points,
+                                         const Eigen::MatrixX3d& normals);
 
 /// The share of the fitted sphere's surface that lies outside the CT's
 /// field of view (beyond its outermost voxel centres), over the directions
