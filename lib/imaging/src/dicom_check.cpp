@@ -20,9 +20,7 @@
 
 namespace articula::imaging {
 
-namespace {
-
-std::vector<double> numbers(const std::string& text) {
+std::vector<double> dicomNumbers(const std::string& text) {
   std::vector<double> out;
   std::stringstream in(text);
   std::string item;
@@ -34,6 +32,8 @@ std::vector<double> numbers(const std::string& text) {
   }
   return out;
 }
+
+namespace {
 
 // The value representations of the elements that describe an image, as the
 // standard gives them: GDCM reads these through typed attributes and aborts
@@ -396,7 +396,7 @@ DicomFileCheck checkDicomFile(const std::filesystem::path& file) {
     if (!walk.atEnd() && walk.big_endian)
       throw Broken("zero bytes follow the last element of a big-endian data set, from byte " +
                    std::to_string(walk.position()));
-    const std::vector<double> frames = numbers(result.header.frames);
+    const std::vector<double> frames = dicomNumbers(result.header.frames);
     if (frames.size() <= 1 && (frames.empty() || frames[0] <= 1))
       if (const std::string problem = codestreamProblem(in, syntax, walk.fragments); !problem.empty()) throw Broken(problem);
     result.kind = DicomFileKind::Complete;
@@ -429,7 +429,7 @@ std::string number(double v) {
 // A multi-valued element as numbers, "(1, 0, 0)": its text shows DICOM's
 // backslash separators escaped.
 std::string shown(const std::string& text) {
-  const std::vector<double> values = numbers(text);
+  const std::vector<double> values = dicomNumbers(text);
   if (values.empty()) return "'" + excerpt(text) + "'";
   if (values.size() == 1) return number(values[0]);
   std::ostringstream out;
@@ -461,11 +461,11 @@ void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector
                                             std::to_string(files.size()) + ")"; };
   if (first.rows <= 0 || first.columns <= 0)
     throw InputError(series + ": " + where(0) + " has no Rows (0028,0010) or Columns (0028,0011); expected an image");
-  const std::vector<double> orientation = numbers(first.orientation);
+  const std::vector<double> orientation = dicomNumbers(first.orientation);
   if (orientation.size() != 6)
     throw InputError(series + ": expected six numbers in Image Orientation Patient (0020,0037) of " + where(0) +
                      ", found " + shown(first.orientation));
-  const std::vector<double> spacing = numbers(first.pixel_spacing);
+  const std::vector<double> spacing = dicomNumbers(first.pixel_spacing);
   if (spacing.size() != 2 || !(spacing[0] > 0 && spacing[1] > 0))
     throw InputError(series + ": expected two positive numbers in Pixel Spacing (0028,0030) of " + where(0) +
                      ", found " + shown(first.pixel_spacing));
@@ -502,7 +502,7 @@ void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector
       throw InputError(series + ": " + where(k) + " stores " + std::to_string(h.bits_allocated) + " bits x " +
                        std::to_string(h.samples_per_pixel) + " samples per pixel, the first slice " +
                        std::to_string(first.bits_allocated) + " x " + std::to_string(first.samples_per_pixel));
-    const std::vector<double> o = numbers(h.orientation);
+    const std::vector<double> o = dicomNumbers(h.orientation);
     double turn = o.size() == 6 ? 0 : 1;
     for (size_t i = 0; i < o.size() && i < 6; ++i) turn = std::max(turn, std::fabs(o[i] - orientation[i]));
     if (turn > 1e-4)
@@ -510,19 +510,19 @@ void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector
                        ", the first slice " + shown(first.orientation) +
                        ": ITK would place every slice in the first one's orientation; remove the slices of another "
                        "image or resample the series");
-    const std::vector<double> s = numbers(h.pixel_spacing);
+    const std::vector<double> s = dicomNumbers(h.pixel_spacing);
     if (s.size() != 2 || std::fabs(s[0] - spacing[0]) > 1e-4 * spacing[0] ||
         std::fabs(s[1] - spacing[1]) > 1e-4 * spacing[1])
       throw InputError(series + ": " + where(k) + " has Pixel Spacing " + shown(h.pixel_spacing) +
                        " mm, the first slice " + shown(first.pixel_spacing) +
                        ": ITK would use the first slice's spacing for all; remove the slices of another image");
     if (!h.rescale_slope.empty()) {
-      const std::vector<double> slope = numbers(h.rescale_slope);
+      const std::vector<double> slope = dicomNumbers(h.rescale_slope);
       if (slope.size() != 1 || slope[0] == 0)
         throw InputError(series + ": " + where(k) + " has Rescale Slope (0028,1053) " + shown(h.rescale_slope) +
                          "; expected a non-zero number (a slope of 0 makes every voxel of the slice one value)");
     }
-    const std::vector<double> frames_text = numbers(h.frames);
+    const std::vector<double> frames_text = dicomNumbers(h.frames);
     const double frames = frames_text.size() == 1 && frames_text[0] >= 1 ? frames_text[0] : 1;
     const double bytes = double(h.rows) * double(h.columns) * frames * std::max(1L, h.samples_per_pixel) *
                          std::max(1.0, double(h.bits_allocated) / 8);
@@ -535,7 +535,7 @@ void checkSeriesHeaders(const std::vector<std::string>& files, const std::vector
                        std::to_string(static_cast<long long>(bytes)) +
                        " bytes): the slice is cut or damaged; replace it or export the series again");
     pixel_bytes += double(h.rows) * double(h.columns) * frames;
-    const std::vector<double> p = numbers(h.position);
+    const std::vector<double> p = dicomNumbers(h.position);
     if (p.size() != 3)
       throw InputError(series + ": expected three numbers in Image Position Patient (0020,0032) of " + where(k) +
                        ", found " + shown(h.position));
@@ -615,12 +615,12 @@ DicomFolder scanDicomFolder(const std::filesystem::path& folder) {
     series.headers.push_back(std::move(check.header));
   }
   for (auto& [uid, series] : by_uid) {
-    const std::vector<double> o = numbers(series.headers.front().orientation);
+    const std::vector<double> o = dicomNumbers(series.headers.front().orientation);
     if (o.size() == 6) {
       const Vec3 normal{o[1] * o[5] - o[2] * o[4], o[2] * o[3] - o[0] * o[5], o[0] * o[4] - o[1] * o[3]};
       std::vector<std::pair<double, size_t>> order;
       for (size_t k = 0; k < series.files.size(); ++k) {
-        const std::vector<double> p = numbers(series.headers[k].position);
+        const std::vector<double> p = dicomNumbers(series.headers[k].position);
         order.emplace_back(p.size() == 3 ? dot({p[0], p[1], p[2]}, normal) : 0.0, k);
       }
       std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -41,6 +41,9 @@ struct DicomFileCheck {
 
 DicomFileCheck checkDicomFile(const std::filesystem::path& file);
 
+/// The numbers of a DS/IS text ("1\0\0"); empty when any is not a finite number.
+std::vector<double> dicomNumbers(const std::string& text);
+
 /// A folder's DICOM images as series, from the walk alone: GDCM then reads
 /// only files that passed it (it aborts the process on some it cannot parse,
 /// and takes files of any content for DICOM). Images (files with pixel data)

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <iomanip>
 #include <limits>
-#include <set>
 #include <sstream>
 #include <vector>
 #include <unistd.h>
@@ -24,7 +23,6 @@
 #include <itkImageFileWriter.h>
 #include <itkImageSeriesReader.h>
 #include <itkImageSeriesWriter.h>
-#include <itkMetaDataObject.h>
 
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
@@ -36,28 +34,6 @@ namespace articula::imaging {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string tagValue(const itk::MetaDataDictionary& dict, const std::string& tag) {
-  std::string value;
-  itk::ExposeMetaData<std::string>(dict, tag, value);
-  // DICOM pads strings to even length with spaces or NULs.
-  while (!value.empty() && (value.back() == ' ' || value.back() == '\0')) value.pop_back();
-  return value;
-}
-
-std::vector<double> parseNumbers(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, '\\')) {
-    try {
-      out.push_back(std::stod(item));
-    } catch (const std::exception&) {
-      return {};
-    }
-  }
-  return out;
-}
 
 // Where a NIfTI header puts its voxels, as its qform and its sform: empty
 // when they agree (or only one is set), the problem otherwise. Without either,
@@ -296,18 +272,17 @@ std::string unreadableList(const ReadReport& report) {
 }
 
 /// Measures slice gaps and gantry tilt from Image Position/Orientation Patient
-/// of every slice, refusing gaps or tilt that ITK would silently mis-place.
-void checkSlices(const std::vector<std::string>& files, const itk::ImageSeriesReader<itk::Image<float, 3>>& reader,
+/// of every slice (as the walk read them), refusing gaps or tilt that ITK
+/// would silently mis-place, before ITK decodes any slice.
+void checkSlices(const std::vector<std::string>& files, const std::vector<DicomSliceHeader>& headers,
                  const ReadOptions& options, ReadReport& report, double& spacing_out) {
-  const auto* dicts = reader.GetMetaDataDictionaryArray();
-  if (!dicts || dicts->size() != files.size()) throw InputError("DICOM series: could not read the slice headers");
-  const std::vector<double> iop = parseNumbers(tagValue(*(*dicts)[0], "0020|0037"));
+  const std::vector<double> iop = dicomNumbers(headers.at(0).orientation);
   if (iop.size() != 6) throw InputError("DICOM series: missing Image Orientation Patient (0020,0037) in " + files[0]);
   const Eigen::Vector3d row(iop[0], iop[1], iop[2]), col(iop[3], iop[4], iop[5]);
   const Eigen::Vector3d normal = row.cross(col).normalized();
   std::vector<Eigen::Vector3d> positions;
   for (size_t k = 0; k < files.size(); ++k) {
-    const std::vector<double> ipp = parseNumbers(tagValue(*(*dicts)[k], "0020|0032"));
+    const std::vector<double> ipp = dicomNumbers(headers[k].position);
     if (ipp.size() != 3) throw InputError("DICOM series: missing Image Position Patient (0020,0032) in " + files[k]);
     positions.emplace_back(ipp[0], ipp[1], ipp[2]);
   }
@@ -393,12 +368,13 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
   const std::vector<std::string>& files = slices.files;
   noteUnreadableFiles(folder, scan, report);
   checkSeriesHeaders(files, slices.headers);
+  double spacing_z = 0;
+  checkSlices(files, slices.headers, options, report, spacing_z);
   using ReaderType = itk::ImageSeriesReader<itk::Image<float, 3>>;
   auto reader = ReaderType::New();
   auto io = itk::GDCMImageIO::New();
   reader->SetImageIO(io);
   reader->SetFileNames(files);
-  reader->MetaDataDictionaryArrayUpdateOn();
   try {
     reader->Update();
   } catch (const itk::ExceptionObject& e) {
@@ -408,8 +384,6 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
     throw InputError("could not decode the DICOM series " + chosen->uid + " in " + folder.string() + ": " +
                      excerpt(e.what()));
   }
-  double spacing_z = 0;
-  checkSlices(files, *reader, options, report, spacing_z);
   Volume volume = fromItk<float>(reader->GetOutput());
   volume.geometry.spacing[2] = spacing_z;  // ITK uses the first two slices only
   return volume;

@@ -59,6 +59,19 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
 constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;                              // warnings of the structure's checks
 
+// A yes-or-no check of how the head was found: 1 passes, 0 warns; no doubt
+// about the structure either way.
+QcCheck flag(const std::string& name, bool ok, const std::string& rule, const std::string& reason) {
+  QcCheck c;
+  c.name = name;
+  c.of_structure = false;
+  c.value = ok ? 1 : 0;
+  c.rule = rule;
+  c.status = ok ? "pass" : "warn";
+  if (!ok) c.reason = reason;
+  return c;
+}
+
 std::string number(double v) {
   std::ostringstream s;
   s.precision(3);
@@ -368,30 +381,18 @@ QcReport checkHead(const HeadQcInput& in) {
     }
     report.checks.push_back(lateral);
   }
-  if (in.found_by_edges) {
-    QcCheck edges;
-    edges.name = "head_found_by_edges";
-    edges.of_structure = false;
-    edges.value = *in.found_by_edges ? 1 : 0;
-    edges.rule = "warn when the search found no sphere through the head's bone edges and took it by its facing surface voxels";
-    edges.status = *in.found_by_edges ? "pass" : "warn";
-    if (!*in.found_by_edges)
-      edges.reason = "the head search found no spherical bone edge along its rays and took the head by the surface "
-                     "voxels facing a centre (its fallback): check the head on the slices";
-    report.checks.push_back(edges);
-  }
-  if (in.side_verified) {
-    QcCheck side;
-    side.name = "side_verified";
-    side.of_structure = false;
-    side.value = *in.side_verified ? 1 : 0;
-    side.rule = "warn when neither the body's middle, a field of view holding both sides, nor the socket tells the side";
-    side.status = *in.side_verified ? "pass" : "warn";
-    if (!*in.side_verified)
-      side.reason = "the joint's side could not be verified (a narrow field of view without the body's outline, and no "
-                    "socket clearly medial to the head): the joint in view was taken as the requested side";
-    report.checks.push_back(side);
-  }
+  if (in.found_by_edges)
+    report.checks.push_back(
+        flag("head_found_by_edges", *in.found_by_edges,
+             "warn when the search found no sphere through the head's bone edges and took it by its facing surface voxels",
+             "the head search found no spherical bone edge along its rays and took the head by the surface voxels "
+             "facing a centre (its fallback): check the head on the slices"));
+  if (in.side_verified)
+    report.checks.push_back(
+        flag("side_verified", *in.side_verified,
+             "warn when neither the body's middle, a field of view holding both sides, nor the socket tells the side",
+             "the joint's side could not be verified (a narrow field of view without the body's outline, and no "
+             "socket clearly medial to the head): the joint in view was taken as the requested side"));
   // Doubts compound: two checks of the structure that each find the head
   // doubtful are two independent signs of a wrong structure (on the phantom matrix, the one
   // head with two warnings had taken part of its socket; no correct head
