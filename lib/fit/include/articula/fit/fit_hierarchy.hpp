@@ -69,6 +69,7 @@ struct Options {
   double c23_min = -0.1, c23_max = 0.1;   // c2, c3
   /// Overrides by parameter name of table 3.2 ("a", "gamma1", "c2x", "t1", ...).
   std::map<std::string, std::pair<double, double>> bounds;
+  UncertaintyMethod uncertainty = UncertaintyMethod::SpatialModel;  // of every reported model
 
   /// Throws UsageError naming the first bad field.
   void validate() const;
