@@ -1,4 +1,4 @@
-// bench-coverage CASES.json: how often the 95 % intervals of a run's fits
+// bench-coverage CASES.json [METHOD ...]: how often the 95 % intervals of a run's fits
 // hold the true head, for each way of computing them (fit/uncertainty.hpp).
 // CASES.json is a list of {"id", "points" (points.ply), "fits" (fits.json),
 // "truth": {"model" (optional, default ellipsoid), "center_mm", "radii_mm",
@@ -61,10 +61,14 @@ Eigen::Vector3d semiAxes(const ShapeParameters& s) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "usage: bench-coverage CASES.json\n";
+    std::cerr << "usage: bench-coverage CASES.json [METHOD ...]\n";
     return 2;
   }
   using articula::fit::UncertaintyMethod;
+  std::vector<UncertaintyMethod> methods = {UncertaintyMethod::Independent, UncertaintyMethod::SpatialModel,
+                                            UncertaintyMethod::SpatialHac, UncertaintyMethod::PatchBootstrap};
+  if (argc > 2) methods.clear();
+  for (int a = 2; a < argc; ++a) methods.push_back(articula::fit::uncertaintyMethodFromName(argv[a]));
   const nlohmann::json cases = nlohmann::json::parse(std::ifstream(argv[1]));
   for (const auto& c : cases) {
     try {
@@ -87,8 +91,7 @@ int main(int argc, char** argv) {
         const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(shape.angles);
         const Eigen::Vector3d semi = semiAxes(shape);
         const bool ovoid = shape.model == ShapeModel::Ovoid || shape.model == ShapeModel::Superovoid;
-        for (auto method : {UncertaintyMethod::Independent, UncertaintyMethod::SpatialModel, UncertaintyMethod::SpatialHac,
-                            UncertaintyMethod::PatchBootstrap}) {
+        for (auto method : methods) {
           const auto u = articula::fit::parameterUncertainty(shape, points, {}, method);
           const auto names = articula::geometry::parameterNames(shape.model);
           auto se_of = [&](const std::string& name) {

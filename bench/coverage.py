@@ -64,6 +64,7 @@ def main():
     ap.add_argument("--independent")
     ap.add_argument("--third")
     ap.add_argument("--out")
+    ap.add_argument("--methods", default="", help="comma-separated (default: all four)")
     a = ap.parse_args()
     cases = []
     for work, make in ((a.robustness, robustness_cases), (a.independent, independent_cases), (a.third, third_cases)):
@@ -73,7 +74,8 @@ def main():
         c["points"], c["fits"] = f"{c['run']}/points.ply", f"{c['run']}/fits.json"
     with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
         json.dump(cases, f)
-    out = subprocess.run([f"{a.bin}/bench-coverage", f.name], check=True, capture_output=True, text=True)
+    methods = [m for m in a.methods.split(",") if m]
+    out = subprocess.run([f"{a.bin}/bench-coverage", f.name, *methods], check=True, capture_output=True, text=True)
     os.unlink(f.name)
     if out.stderr:
         print(out.stderr, file=sys.stderr)
@@ -112,6 +114,8 @@ def report(rows, selected, sets):
                   "|---|---|---|---|---|---|---|"]
         for m in methods:
             h = [r for r in g if r["method"] == m]
+            if not h:
+                continue
             cz = [z for r in h for z in r["centre_z"]]
             rz = [z for r in h for z in r["radius_z"]]
             oz = [z for r in h for z in r["radius_less_offset_z"]]
@@ -122,6 +126,8 @@ def report(rows, selected, sets):
         lines += ["", "| method (the true model's own fit) | fits | centre | semi-axes less the shared offset |", "|---|---|---|---|"]
         for m in methods:
             h = [r for r in own if r["method"] == m]
+            if not h:
+                continue
             lines.append(f"| {m} | {len(h)} | {share([z for r in h for z in r['centre_z']])[0]} | "
                          f"{share([z for r in h for z in r['radius_less_offset_z']])[0]} |")
         sm = [r for r in g if r["method"] == "spatial-model"]

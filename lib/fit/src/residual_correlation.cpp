@@ -95,7 +95,7 @@ ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, 
       const double g = b.sum_sq / (2.0 * static_cast<double>(b.count));
       h.push_back(b.sum_h / static_cast<double>(b.count));
       gamma.push_back(g);
-      weight.push_back(static_cast<double>(b.count) / (g * g));  // Cressie's N_h / gamma^2, at the empirical gamma
+      weight.push_back(static_cast<double>(b.count));
     }
   if (h.size() < 3) return out;
   // Lengths from a fiftieth of a bin to half the extent, 40 per grid.

@@ -34,7 +34,6 @@ double uselessHalfWidth(geometry::ParameterKind kind) {
 }
 
 bool isOvoid(ShapeModel m) { return m == ShapeModel::Ovoid || m == ShapeModel::Superovoid; }
-
 // The meat J^T Sigma J of the sandwich (#k x #k) in the scaled columns of
 // `J`, for the chosen method (SpatialModel's before its level is set).
 Eigen::MatrixXd meat(UncertaintyMethod method, const Eigen::MatrixX3d& points, const Eigen::MatrixXd& J,
@@ -190,10 +189,13 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
   out.ci95_upper = Eigen::VectorXd::Constant(m, std::numeric_limits<double>::infinity());
   for (Eigen::Index j = 0; j < m; ++j)
     if (held[static_cast<size_t>(j)]) out.gauge.push_back(names[static_cast<size_t>(j)]);
+  std::vector<char> open(static_cast<size_t>(k), 0);
+  for (Eigen::Index a = 0; a < k; ++a)
+    for (Eigen::Index q = 0; q < k; ++q)
+      open[static_cast<size_t>(a)] |= weak[static_cast<size_t>(q)] && std::abs(V(a, q)) > 1e-3;
   for (Eigen::Index a = 0; a < k; ++a) {
     const Eigen::Index j = active[static_cast<size_t>(a)];
-    bool free = false;
-    for (Eigen::Index q = 0; q < k; ++q) free = free || (weak[static_cast<size_t>(q)] && std::abs(V(a, q)) > 1e-3);
+    const bool free = open[static_cast<size_t>(a)];
     const double canonical = free ? std::numeric_limits<double>::infinity()
                                   : std::sqrt(std::max(covariance(a, a), 0.0)) / scale[a];
     const double se = canonical * to_raw[j];

@@ -39,9 +39,9 @@ struct ResidualCorrelation {
 };
 
 /// The semivariogram of `residual` (#P) over `points` (#P x 3, mm) and its
-/// nugget + two-exponential fit (non-negative weighted least squares over 32
-/// distance bins up to half the points' extent, the weights the bins' pair
-/// counts over the squared semivariance, the lengths searched on a log grid). More than 3,000 points:
+/// nugget + two-exponential fit (non-negative least squares over 32 distance
+/// bins up to half the points' extent, weighted by the bins' pair counts, the
+/// lengths searched on a log grid). More than 3,000 points:
 /// the variogram is taken from a seeded random 3,000 of them; n_eff from all.
 ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, const Eigen::VectorXd& residual,
                                                 unsigned seed = 1);
