@@ -99,7 +99,14 @@ NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer
   const int n = richer.n_points;
   step.df1 = richer.n_parameters - simpler.n_parameters;
   step.df2 = n - richer.n_parameters;
-  step.n_eff = std::isfinite(richer.n_eff) ? std::min(richer.n_eff, static_cast<double>(n)) : n;
+  // Each model's residuals misjudge the noise in one direction: the
+  // simpler model's hold the richer model's gain as if it were correlated
+  // noise (n_eff too low where the richer model is right), the richer
+  // model's have absorbed part of the noise (n_eff too high where the
+  // simpler one is right). Their geometric mean is used.
+  const double n_simpler = std::isfinite(simpler.n_eff) ? std::min(simpler.n_eff, static_cast<double>(n)) : n;
+  const double n_richer = std::isfinite(richer.n_eff) ? std::min(richer.n_eff, static_cast<double>(n)) : n;
+  step.n_eff = std::sqrt(n_simpler * n_richer);
   if (step.df1 <= 0 || step.df2 <= 0 || !(richer.sse_mm2 > 0) || !std::isfinite(simpler.sse_mm2)) return step;
   // The hierarchy keeps SSE_r <= SSE_s; a hair above from rounding is no fall.
   const double fall = std::max(0.0, simpler.sse_mm2 - richer.sse_mm2);

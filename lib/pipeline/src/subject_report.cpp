@@ -331,7 +331,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
        {{"rule",
          "among the models the points determine (not undetermined), from the sphere: every model containing the "
          "current one is tested against it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "
-         "n_eff the richer model's effective number of independent points) at alpha / their number; the simplest "
+         "n_eff the geometric mean of the two models' effective numbers of independent points) at alpha / their "
+         "number; the simplest "
          "that passes becomes the current model, until none passes"},
         {"alpha", o.selection_alpha},
         {"steps", steps_json},

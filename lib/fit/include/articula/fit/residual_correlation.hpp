@@ -21,6 +21,7 @@
 // residuals' mean as precisely), and the sums of kernels over point pairs
 // the sandwich covariance needs (kernelGram), accumulated over cells so that
 // 10^5 points cost about what 10^3 do.
+#include <cmath>
 #include <functional>
 
 #include <Eigen/Cholesky>
@@ -36,6 +37,12 @@ struct ResidualCorrelation {
   int n = 0;                              // points
   double variance() const { return nugget_mm2 + sill_mm2.sum(); }
   double correlatedShare() const { return variance() > 0 ? sill_mm2.sum() / variance() : 0.0; }
+  /// The length of the one exponential whose correlated area (the integral
+  /// of the correlation over the surface, 2 pi L^2) the two parts share.
+  double effectiveLength() const {
+    const double s = sill_mm2.sum();
+    return s > 0 ? std::sqrt((sill_mm2.array() * length_mm.array().square()).sum() / s) : 0.0;
+  }
 };
 
 /// The semivariogram of `residual` (#P) over `points` (#P x 3, mm) and its

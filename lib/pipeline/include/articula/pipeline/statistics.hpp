@@ -37,8 +37,10 @@ double bic(double sse, int n, int k);
 /// the points the residuals' spatial correlation leaves (fit/residual_correlation.hpp).
 ///
 /// The test of a simpler model against a richer one that contains it is the
-/// F test of the fall of the sum of squared distances with the richer
-/// model's effective number of independent points n_eff:
+/// F test of the fall of the sum of squared distances with an effective
+/// number of independent points n_eff, the geometric mean of the two
+/// models' (the simpler model's residuals count the richer model's gain as
+/// correlated noise, the richer model's have absorbed part of the noise):
 ///   F = ((SSE_s - SSE_r) / (k_r - k_s)) / (SSE_r / (n - k_r)) x n_eff / n,
 /// on (k_r - k_s, n - k_r) degrees of freedom. A smooth error field (blur,
 /// partial volume, anisotropic voxels) projects onto a richer model's extra
@@ -70,7 +72,7 @@ struct NestedStep {
   std::string simpler, richer;
   double f = NAN;          // the statistic above
   int df1 = 0, df2 = 0;
-  double n_eff = NAN;      // the richer model's, as used
+  double n_eff = NAN;      // as used: the geometric mean of the two models'
   double p_value = NAN;    // P(F(df1, df2) >= f)
   double alpha = NAN;      // the level it was judged at
   bool richer_needed = false;  // p_value < alpha
