@@ -130,6 +130,13 @@ def report(rows, selected, sets):
                 continue
             lines.append(f"| {m} | {len(h)} | {share([z for r in h for z in r['centre_z']])[0]} | "
                          f"{share([z for r in h for z in r['radius_less_offset_z']])[0]} |")
+        lines += ["", "| fitted model | method | fits | centre | semi-axes less the shared offset |", "|---|---|---|---|---|"]
+        for model in ["sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid"]:
+            for m in methods:
+                h = [r for r in g if r["method"] == m and r["model"] == model]
+                if h:
+                    lines.append(f"| {model} | {m} | {len(h)} | {share([z for r in h for z in r['centre_z']])[0]} | "
+                                 f"{share([z for r in h for z in r['radius_less_offset_z']])[0]} |")
         sm = [r for r in g if r["method"] == "spatial-model"]
         if sm:
             lines.append(f"\nmedian n_eff {median([r['n_eff'] for r in sm]):.1f} of median n {median([r['n'] for r in sm])}; "

@@ -121,7 +121,7 @@ ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, 
   const double step = std::pow(l_max / l_min, 1.0 / (kGrid - 1.0));
   for (int g = -10; g <= 10; ++g) {
     Eigen::Vector3d c;
-    const double l = l_one * std::pow(step, g / 10.0);
+    const double l = std::clamp(l_one * std::pow(step, g / 10.0), l_min, l_max);
     const double sse = fitAtLengths(h, gamma, weight, l, l, c);
     if (sse < one) one = sse, c_one = c, l_one = l;
   }
@@ -129,7 +129,8 @@ ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, 
   for (int ga = -5; ga <= 5; ++ga)
     for (int gb = -5; gb <= 5; ++gb) {
       Eigen::Vector3d c;
-      const double la = a0 * std::pow(step, ga / 5.0), lb = b0 * std::pow(step, gb / 5.0);
+      const double la = std::clamp(a0 * std::pow(step, ga / 5.0), l_min, l_max);
+      const double lb = std::clamp(b0 * std::pow(step, gb / 5.0), l_min, l_max);
       if (la >= lb) continue;
       const double sse = fitAtLengths(h, gamma, weight, la, lb, c);
       if (sse < two) two = sse, c_two = c, l_two_a = la, l_two_b = lb;
