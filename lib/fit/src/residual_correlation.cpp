@@ -4,13 +4,12 @@
 #include <cmath>
 #include <numeric>
 #include <random>
-#include <unordered_map>
 #include <vector>
 
 namespace articula::fit {
 namespace {
 
-constexpr int kVariogramPoints = 3000;
+constexpr int kVariogramPoints = 2000;
 constexpr int kBins = 32;
 constexpr int kMaxCellsAlong = 48;  // cells of at least 1/48 of the extent: at most a few thousand on a cap
 constexpr int kSameCellSample = 16;  // points of a cell whose pairs give its mean kernel
@@ -57,8 +56,13 @@ double fitAtLengths(const std::vector<double>& h, const std::vector<double>& gam
 
 }  // namespace
 
+double nEffective(const ResidualCorrelation& c, double covariance_sum) {
+  return covariance_sum > 0 ? static_cast<double>(c.n) * static_cast<double>(c.n) * c.variance() / covariance_sum
+                            : static_cast<double>(c.n);
+}
+
 ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, const Eigen::VectorXd& residual,
-                                                unsigned seed) {
+                                                unsigned seed, bool with_n_eff) {
   ResidualCorrelation out;
   const Eigen::Index n = points.rows();
   out.n = static_cast<int>(n);
@@ -151,15 +155,13 @@ ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, 
     std::swap(out.sill_mm2[0], out.sill_mm2[1]);
     std::swap(out.length_mm[0], out.length_mm[1]);
   }
-  if (out.sill_mm2.sum() > 0) {
-    // n_eff = n^2 var / sum_ij cov_ij: the variance of the residuals' mean is var / n_eff.
-    const double pair_sum = covarianceGram(points, Eigen::MatrixXd::Ones(n, 1), out)(0, 0);
-    out.n_eff = static_cast<double>(n) * static_cast<double>(n) * out.variance() / pair_sum;
-  }
+  // n_eff = n^2 var / sum_ij cov_ij: the variance of the residuals' mean is var / n_eff.
+  if (with_n_eff && out.sill_mm2.sum() > 0)
+    out.n_eff = nEffective(out, covarianceGram(points, Eigen::MatrixXd::Ones(n, 1), out)(0, 0));
   return out;
 }
 
-Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd& a,
+Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
                            const std::function<double(double)>& kernel, double reach_mm, double cell_mm) {
   const Eigen::Index n = points.rows(), m = a.cols();
   Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(m, m);
@@ -167,21 +169,27 @@ Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd
   const Eigen::Vector3d lo = points.colwise().minCoeff().transpose();
   const double extent = (points.colwise().maxCoeff().transpose() - lo).maxCoeff();
   const double cell = std::max({cell_mm, extent / kMaxCellsAlong, 1e-9});
-  // Cells by their integer coordinates.
-  std::unordered_map<long long, int> index;
+  // Cells on a dense grid of at most 49^3 (kMaxCellsAlong + 1 along each axis).
+  const Eigen::Vector3i dims =
+      ((points.colwise().maxCoeff().transpose() - lo) / cell).array().floor().cast<int>() + 1;
+  std::vector<int> index(static_cast<size_t>(dims.prod()), -1);
+  const auto flat = [&dims](const Eigen::Vector3i& c) {
+    return static_cast<size_t>((c[0] * dims[1] + c[1]) * dims[2] + c[2]);
+  };
   std::vector<int> cell_of(static_cast<size_t>(n));
   std::vector<Eigen::Vector3i> coords;
   std::vector<std::vector<Eigen::Index>> members;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3i c = ((points.row(i).transpose() - lo) / cell).array().floor().cast<int>();
-    const long long key = (static_cast<long long>(c[0]) << 42) ^ (static_cast<long long>(c[1]) << 21) ^ c[2];
-    auto [it, added] = index.emplace(key, static_cast<int>(coords.size()));
-    if (added) {
+    const Eigen::Vector3i c =
+        ((points.row(i).transpose() - lo) / cell).array().floor().cast<int>().min(dims.array() - 1).max(0);
+    int& at = index[flat(c)];
+    if (at < 0) {
+      at = static_cast<int>(coords.size());
       coords.push_back(c);
       members.emplace_back();
     }
-    cell_of[static_cast<size_t>(i)] = it->second;
-    members[static_cast<size_t>(it->second)].push_back(i);
+    cell_of[static_cast<size_t>(i)] = at;
+    members[static_cast<size_t>(at)].push_back(i);
   }
   const int cells = static_cast<int>(coords.size());
   Eigen::MatrixXd sums = Eigen::MatrixXd::Zero(cells, m);
@@ -209,9 +217,16 @@ Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd
   gram += sums.transpose() * same.asDiagonal() * sums;
   // Between cells: each cell's kernel-weighted sum of its neighbours.
   Eigen::MatrixXd neighbours = Eigen::MatrixXd::Zero(cells, m);
+  // Neighbouring cells: the offsets whose nearest points may lie within reach.
   const int r = static_cast<int>(std::ceil(reach_mm / cell));
-  const double offsets = std::pow(2.0 * r + 1.0, 3);
-  if (offsets >= cells) {
+  std::vector<Eigen::Vector3i> offsets;
+  for (int dx = -r; dx <= r; ++dx)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dz = -r; dz <= r; ++dz) {
+        const Eigen::Vector3d gap = (Eigen::Vector3i(dx, dy, dz).cwiseAbs().array() - 1).max(0).cast<double>() * cell;
+        if ((dx || dy || dz) && gap.norm() <= reach_mm) offsets.emplace_back(dx, dy, dz);
+      }
+  if (offsets.size() >= static_cast<size_t>(cells)) {
     for (int c = 0; c < cells; ++c)
       for (int d = c + 1; d < cells; ++d) {
         const double h = (centroid.row(c) - centroid.row(d)).norm();
@@ -222,29 +237,27 @@ Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd
       }
   } else {
     for (int c = 0; c < cells; ++c)
-      for (int dx = -r; dx <= r; ++dx)
-        for (int dy = -r; dy <= r; ++dy)
-          for (int dz = -r; dz <= r; ++dz) {
-            if (!dx && !dy && !dz) continue;
-            const Eigen::Vector3i o = coords[static_cast<size_t>(c)] + Eigen::Vector3i(dx, dy, dz);
-            if (o.minCoeff() < 0) continue;  // no cell there (and the key would not be unique)
-            const long long key = (static_cast<long long>(o[0]) << 42) ^ (static_cast<long long>(o[1]) << 21) ^ o[2];
-            const auto it = index.find(key);
-            if (it == index.end()) continue;
-            const double h = (centroid.row(c) - centroid.row(it->second)).norm();
-            if (h <= reach_mm) neighbours.row(c) += kernel(h) * sums.row(it->second);
-          }
+      for (const Eigen::Vector3i& offset : offsets) {
+        const Eigen::Vector3i o = coords[static_cast<size_t>(c)] + offset;
+        if ((o.array() < 0).any() || (o.array() >= dims.array()).any()) continue;
+        const int d = index[flat(o)];
+        if (d < 0) continue;
+        const double h = (centroid.row(c) - centroid.row(d)).norm();
+        if (h <= reach_mm) neighbours.row(c) += kernel(h) * sums.row(d);
+      }
   }
   gram += sums.transpose() * neighbours;
   return 0.5 * (gram + gram.transpose());
 }
 
-Eigen::MatrixXd exponentialGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd& a, double length_mm) {
+Eigen::MatrixXd exponentialGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                                double length_mm) {
   return kernelGram(points, a, [length_mm](double h) { return std::exp(-h / length_mm); }, 6.0 * length_mm,
                     0.5 * length_mm);
 }
 
-Eigen::MatrixXd covarianceGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd& a, const ResidualCorrelation& c) {
+Eigen::MatrixXd covarianceGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                               const ResidualCorrelation& c) {
   Eigen::MatrixXd gram = c.nugget_mm2 * (a.transpose() * a);
   for (int k = 0; k < 2; ++k)
     if (c.sill_mm2[k] > 0 && c.length_mm[k] > 0) gram += c.sill_mm2[k] * exponentialGram(points, a, c.length_mm[k]);

@@ -48,25 +48,33 @@ struct ResidualCorrelation {
 /// The semivariogram of `residual` (#P) over `points` (#P x 3, mm) and its
 /// nugget + two-exponential fit (non-negative least squares over 32 distance
 /// bins up to half the points' extent, weighted by the bins' pair counts, the
-/// lengths searched on a log grid). More than 3,000 points:
-/// the variogram is taken from a seeded random 3,000 of them; n_eff from all.
+/// lengths searched on a log grid). More than 2,000 points: the variogram
+/// is taken from a seeded random 2,000 of them; n_eff from all (left at n
+/// with `with_n_eff` false, for a caller that sums the covariance itself:
+/// nEffective).
 ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, const Eigen::VectorXd& residual,
-                                                unsigned seed = 1);
+                                                unsigned seed = 1, bool with_n_eff = true);
+
+/// n_eff = n^2 var / sum_ij cov_ij from the sum of the covariance over
+/// every pair of n points (1^T Sigma 1).
+double nEffective(const ResidualCorrelation& c, double covariance_sum);
 
 /// sum_i sum_j k(|x_i - x_j|) a_i a_j^T (#m x #m; a_i the rows of `a`, k(0)
 /// included), for a kernel that vanishes beyond `reach_mm`. Pairs are taken
 /// cell by cell (cells of `cell_mm`, at least 1/48 of the extent): between
 /// two cells at their centroids' distance, within one at the mean kernel of
 /// its points' pairs, exactly on the diagonal.
-Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd& a,
+Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
                            const std::function<double(double)>& kernel, double reach_mm, double cell_mm);
 
 /// The exponential kernel exp(-h / L), cut at 6 L (where it has fallen to
 /// 0.25 %), through kernelGram.
-Eigen::MatrixXd exponentialGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd& a, double length_mm);
+Eigen::MatrixXd exponentialGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                                double length_mm);
 
 /// a^T Sigma a for the covariance Sigma of `c` (nugget on the diagonal, each
 /// correlated part through exponentialGram).
-Eigen::MatrixXd covarianceGram(const Eigen::MatrixX3d& points, const Eigen::MatrixXd& a, const ResidualCorrelation& c);
+Eigen::MatrixXd covarianceGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                               const ResidualCorrelation& c);
 
 }  // namespace articula::fit
