@@ -722,7 +722,7 @@ const ModelFit& Summary::fit(ShapeModel model) const {
 
 std::string Summary::briefReport() const {
   std::ostringstream s;
-  s << "fitted " << fits.size() << " models to " << points << " points in " << seconds << " s; best: " << best_model;
+  s << "fitted " << fits.size() << " models to " << points << " points in " << seconds << " s; least RMS: " << best_model;
   return s.str();
 }
 

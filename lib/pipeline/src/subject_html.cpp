@@ -102,7 +102,7 @@ std::string verdictSection(const json& results) {
   html += "<table><tr><th>selected model</th><td id=\"selected-model\">" + report::escapeMarkup(selected) + "</td></tr>\n";
   const std::string least = text(results, "least_rms_model");
   if (!least.empty() && least != selected)
-    html += "<tr><th>least RMS (not selected: its extra parameters fail the nested test)</th><td id=\"least-rms\">" +
+    html += "<tr><th>least RMS (not selected)</th><td id=\"least-rms\">" +
             report::escapeMarkup(least) + "</td></tr>\n";
   std::string open_models;
   for (const auto& m : member(member(results, "selection"), "undetermined"))
@@ -148,6 +148,14 @@ std::string checksSection(const json& results) {
   return html + "</table></section>\n";
 }
 
+// A p-value to three significant digits.
+std::string probability(double p) {
+  if (!std::isfinite(p)) return "-";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", p);
+  return buffer;
+}
+
 // The nested tests of the model selection: the hierarchy's steps, each at
 // alpha, and the walk's tests at their levels.
 std::string selectionTable(const json& results) {
@@ -163,7 +171,7 @@ std::string selectionTable(const json& results) {
       html += "<tr class=\"" + kind + "\"><td>" + report::escapeMarkup(text(st, "simpler")) + " &rarr; " +
               report::escapeMarkup(text(st, "richer")) + (kind == "path" ? " (walk)" : "") + "</td><td>" +
               fixed(numberAt(st, "f"), 2) + "</td><td>" + text(st, "df1") + ", " + text(st, "df2") + "</td><td>" +
-              fixed(numberAt(st, "n_eff"), 0) + "</td><td>" + report::escapeMarkup(text(st, "p_value")) + "</td><td>" +
+              fixed(numberAt(st, "n_eff"), 0) + "</td><td>" + probability(numberAt(st, "p_value")) + "</td><td>" +
               fixed(numberAt(st, "alpha"), 4) + "</td><td>" + (member(st, "richer_needed") == true ? "yes" : "no") +
               "</td></tr>\n";
   };

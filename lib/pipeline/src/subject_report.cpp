@@ -185,7 +185,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     throw InputError("cannot read the error summary '" + summary_path.string() + "': " + e.what());
   }
   const auto shapes = fit::shapesFromFitsJson(fits, fits_path.string());
-  const std::string best = fits.value("best_model", "");  // the least RMS
+  const std::string best = fits.value("least_rms_model", fits.value("best_model", ""));
   json models = json::array();
   std::vector<std::string> csv_header = {"model", "n_parameters", "aic", "bic", "least_rms"};
   std::string csv_rows;

@@ -91,7 +91,7 @@ struct ModelFit {
 
 struct Summary {
   std::vector<ModelFit> fits;      // in hierarchy order, only the requested models
-  std::string best_model;          // lowest RMS; ties go to the simpler model
+  std::string best_model;          // lowest RMS (fits.json "least_rms_model"); ties go to the simpler model
   int points = 0;
   double seconds = 0.0;
   std::string briefReport() const;
