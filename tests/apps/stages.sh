@@ -93,7 +93,7 @@ for m in r["models"]:
         assert re.search(r'id="semi-axes">' + r'(?: &plusmn; [0-9.]+)?, '.join("%.2f" % x for x in axes), html), "semi-axes not shown"
 assert 'class="status %s"' % r["qc"]["status"] in html
 # The selection's evidence: the hierarchy's five steps, each a nested F test
-# with the richer model's n_eff, and the walk that chose the model; on the
+# with the two models' n_eff, and the walk that chose the model; on the
 # page as a table; the least-RMS model named only where it is another.
 sel = r["selection"]
 assert [(st["simpler"], st["richer"]) for st in sel["steps"]] == [
@@ -102,7 +102,8 @@ assert [(st["simpler"], st["richer"]) for st in sel["steps"]] == [
 by_model = {m["model"]: m for m in r["models"]}
 for st in sel["steps"] + sel["path"]:
     assert 0 <= st["p_value"] <= 1 and st["f"] >= 0 and st["richer_needed"] == (st["p_value"] < st["alpha"]), st
-    assert abs(st["n_eff"] - by_model[st["richer"]]["residual_correlation"]["n_eff"]) < 1e-6 * st["n_eff"], st
+    both = by_model[st["simpler"]]["residual_correlation"]["n_eff"] * by_model[st["richer"]]["residual_correlation"]["n_eff"]
+    assert abs(st["n_eff"] - both ** 0.5) < 1e-6 * st["n_eff"], st  # the geometric mean of the two models' n_eff
     assert 1 <= st["n_eff"] <= by_model[st["richer"]]["errors"]["n_points"], st
 assert sel["path"] and sel["path"][0]["simpler"] == "sphere", sel["path"]
 # The walk ends where no richer model passes: the selected model's own tests all fail.
