@@ -14,6 +14,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
+#include "arthritis.hpp"
 
 namespace articula::phantom {
 namespace {
@@ -107,6 +108,7 @@ struct Anatomy {
   std::vector<Box> pelvis_blocks;     // sacrum and pubic symphysis (both hips)
   double socket_half_angle_cos = std::cos(80.0 * M_PI / 180.0);
   Vector3d wave_phase = Vector3d::Zero();
+  std::vector<Cyst> cysts;  // of the requested side's head
   const PhantomOptions* o = nullptr;
 
   /// Depth inside a hip's acetabulum: a shell of the wall's thickness,
@@ -116,12 +118,20 @@ struct Anatomy {
     const Vector3d from_pole_centre = x - h.truth.socket_center;
     const double r = from_pole_centre.norm();
     const double cone = r * (from_pole_centre.dot(h.truth.socket_axis) / std::max(r, 1e-12) - socket_half_angle_cos);
-    if (o->congruent_socket) {
-      const double outside = -head_depth;
-      return std::min({outside - o->gap_mm, o->gap_mm + o->socket_wall_mm - outside, cone});
-    }
+    const double outside = -head_depth;
     const double inner = h.truth.socket_inner_radius_mm;
-    return std::min({r - inner, inner + o->socket_wall_mm - r, cone});
+    const double depth = o->congruent_socket ? std::min({outside - o->gap_mm, o->gap_mm + o->socket_wall_mm - outside, cone})
+                                             : std::min({r - inner, inner + o->socket_wall_mm - r, cone});
+    if (!h.truth.narrow_gap) return depth;
+    // A narrowed joint: the socket's inner surface advances from its own
+    // distance to the head to the narrow gap over the patch (its outer
+    // surface stays), smoothly back at the patch's edge.
+    const double w = h.truth.narrow_gap->weight(x - h.center);
+    if (w <= 0) return depth;
+    const double own_gap = o->congruent_socket ? o->gap_mm : outside + inner - r;
+    const double gap = own_gap - w * (own_gap - h.truth.narrow_gap->gap_mm);
+    const double outer = o->congruent_socket ? o->gap_mm + o->socket_wall_mm - outside : inner + o->socket_wall_mm - r;
+    return std::max(depth, std::min({outside - gap, outer, cone}));
   }
 
   /// Cancellous HU at x: uniform, or varying smoothly (wavelength 30 mm).
@@ -153,7 +163,15 @@ struct Anatomy {
     interface = std::min({std::fabs(femur), std::fabs(femur - cortex), std::fabs(pelvis), std::fabs(pelvis - cortex)});
     const double bone = std::max(femur, pelvis);
     if (bone <= 0) return o->soft_tissue_hu;
-    if (femur >= pelvis) return bone < cortex ? o->cortical_hu : cancellous(o->cancellous_hu, x);
+    if (femur >= pelvis) {
+      // Subchondral cysts: fluid balls in the cancellous bone.
+      for (const Cyst& cyst : cysts) {
+        const double depth = cyst.radius_mm - (x - cyst.center).norm();
+        interface = std::min(interface, std::fabs(depth));
+        if (depth > 0 && bone >= cortex) return o->cyst_hu;
+      }
+      return bone < cortex ? o->cortical_hu : cancellous(o->cancellous_hu, x);
+    }
     return bone < cortex ? o->socket_cortical_hu.value_or(o->cortical_hu)
                          : cancellous(o->socket_cancellous_hu.value_or(o->cancellous_hu), x);
   }
@@ -290,15 +308,44 @@ nlohmann::json hipTruth(const Hip& hip, const PhantomOptions& o) {
   };
   if (hip.fovea)
     t["fovea"] = {{"center_mm", vec(hip.fovea_center)}, {"radius_mm", hip.fovea_radius_mm}, {"depth_mm", o.fovea_depth_mm}};
+  const nlohmann::json departures = detail::departuresJson(hip, o);
+  if (!departures.empty()) t["departures"] = departures;
   return t;
 }
+
+Vector3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
 
 }  // namespace
 
 double headSurfaceDistance(const Hip& hip, double head_distance_mm, const Eigen::Vector3d& x) {
-  if (!hip.fovea) return head_distance_mm;
+  double d = head_distance_mm;
   // The head less the pit's ball: max(d_head, -d_ball), exact away from the pit's rim.
-  return std::max(head_distance_mm, hip.fovea_radius_mm - (x - hip.fovea_center).norm());
+  if (hip.fovea) d = std::max(d, hip.fovea_radius_mm - (x - hip.fovea_center).norm());
+  // Less the half-space beyond a flattened dome's plane; with the lip added.
+  if (hip.flat_dome) d = std::max(d, (x - hip.flat_dome->point).dot(hip.flat_dome->normal));
+  if (hip.osteophytes) d = std::min(d, hip.osteophytes->distance(x));
+  return d;
+}
+
+Hip hipFromTruth(const nlohmann::json& t) {
+  Hip hip;
+  hip.right = t.at("side") == "right";
+  geometry::ShapeParameters& p = hip.head;
+  p.model = geometry::modelFromName(t.at("model").get<std::string>());
+  p.radii = vec3(t.at("radii_mm"));
+  p.exponents = vec3(t.at("exponents"));
+  for (int n = 0; n < 4; ++n) p.cx[n] = t.at("cx")[n].get<double>(), p.cy[n] = t.at("cy")[n].get<double>();
+  p.center = vec3(t.at("head_center_mm"));
+  p.angles = vec3(t.at("angles_rad"));
+  if (t.contains("neck_axis")) hip.neck_axis = vec3(t["neck_axis"]);
+  if (t.contains("socket_axis")) hip.socket_axis = vec3(t["socket_axis"]);
+  if (t.contains("fovea")) {
+    hip.fovea = true;
+    hip.fovea_center = vec3(t["fovea"]["center_mm"]);
+    hip.fovea_radius_mm = t["fovea"]["radius_mm"].get<double>();
+  }
+  if (t.contains("departures")) detail::departuresFromJson(t["departures"], hip);
+  return hip;
 }
 
 void PhantomOptions::makeOsteoporotic() {
@@ -323,6 +370,10 @@ void PhantomOptions::validate() const {
   if (!(socket_excess_mm >= 0 && socket_excess_mm <= 15)) throw UsageError("phantom --socket-excess: expected 0 to 15 mm");
   if (!(fovea_radius_mm > 0 && fovea_depth_mm > 0 && fovea_depth_mm < fovea_radius_mm && fovea_radius_mm <= 10))
     throw UsageError("phantom fovea: expected 0 < depth < radius <= 10 mm");
+  if (!(flattened_dome >= 0 && flattened_dome <= 0.5)) throw UsageError("phantom --flattened-dome: expected 0 to 0.5 of the radius");
+  if (!(osteophytes_mm >= 0 && osteophytes_mm <= 6)) throw UsageError("phantom --osteophytes: expected 0 to 6 mm");
+  if (!(narrow_gap_mm == 0 || (narrow_gap_mm >= 0.3 && narrow_gap_mm < gap_mm)))
+    throw UsageError("phantom --narrow-gap: expected 0.3 mm to less than the joint's --gap");
 }
 
 Phantom makePhantom(const PhantomOptions& o) {
@@ -344,6 +395,9 @@ Phantom makePhantom(const PhantomOptions& o) {
     const geometry::ShapeParameters head = drawHead(o, model, sides[n] ? -1.0 : 1.0, uniform, r0);
     a.hips.push_back(makeHip(o, head, r0, sides[n]));
   }
+  HipAnatomy& requested = a.hips[0];
+  detail::addArthritis(o, *requested.head, requested.r0, requested.neck_radius, requested.truth);
+  a.cysts = requested.truth.cysts;
   if (o.cancellous_variation_hu > 0) a.wave_phase = Vector3d(uniform(0, 2 * M_PI), uniform(0, 2 * M_PI), uniform(0, 2 * M_PI));
 
   // The grid: head, socket and pelvis medially, neck and shaft laterally.
