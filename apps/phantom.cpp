@@ -76,6 +76,15 @@ class PhantomCommand : public cli::Command {
                    "the cap (within 20 degrees of superior, back to --gap at 32), as cartilage loss where the hip "
                    "bears weight")
         ->capture_default_str();
+    // What the scan adds; truth.json records each.
+    fov_cut_ = app.add_option("--fov-cut", fov_cut_value_,
+                   "A field of view that clips the --side head: the stored image ends at a plane across --fov-face "
+                   "with the head reaching this FRACTION of its radius beyond the last voxels (0: tangent, up to "
+                   "0.9), as a scan framed too tightly");
+    app.add_option("--fov-face", fov_face_,
+                   "The face of the field of view that --fov-cut moves in: +x, -x, +y, -y, +z, -z (LPS: left, right, "
+                   "posterior, anterior, superior, inferior; or L, R, P, A, S, I)")
+        ->capture_default_str();
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
@@ -101,6 +110,11 @@ class PhantomCommand : public cli::Command {
     o.osteophytes_mm = options_.osteophytes_mm;
     o.cysts = options_.cysts;
     o.narrow_gap_mm = options_.narrow_gap_mm;
+    if (fov_cut_->count()) {
+      if (!(fov_cut_value_ >= 0)) throw UsageError("--fov-cut: expected a fraction of the radius from 0 to 0.9");
+      o.fov_cut = fov_cut_value_;
+      o.fov_face = phantom::faceDirection(fov_face_);
+    }
     if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer");
     o.seed = static_cast<unsigned long long>(common.seed);
     if (!model_.empty()) o.model = geometry::modelFromName(model_);
@@ -169,9 +183,11 @@ class PhantomCommand : public cli::Command {
   std::vector<double> radius_range_ = {20.0, 25.0};
   std::string socket_ = "congruent";
   double socket_cortical_hu_ = 0, socket_cancellous_hu_ = 0;
+  double fov_cut_value_ = 0;
+  std::string fov_face_ = "+z";
   phantom::PhantomOptions options_;  // holds the parsed values of the bone and socket options
   CLI::Option *radius_option_ = nullptr, *cortical_hu_ = nullptr, *cancellous_hu_ = nullptr, *cortical_mm_ = nullptr, *variation_ = nullptr,
-              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr;
+              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr, *fov_cut_ = nullptr;
 };
 
 ARTICULA_REGISTER_COMMAND(PhantomCommand)

@@ -506,5 +506,43 @@ TEST(Phantom, ArthritisLeavesTheRestOfTheSeedsCt) {
   EXPECT_THROW(phantom::makePhantom(o), UsageError);
 }
 
+// A clipped field of view: the stored grid's last layer of voxel centres
+// lies on the plane fraction x radius inside the head's extent along the
+// face; the head's farthest point beyond it is outside the grid, and the
+// layer at the plane still holds the head's bone.
+TEST(Phantom, FieldOfViewCutEndsTheGridInsideTheHead) {
+  for (const auto& [face, ras] : {std::pair<std::string, bool>{"+z", false}, {"-x", true}, {"A", false}}) {
+    phantom::PhantomOptions o = clean(18);
+    o.model = geometry::ShapeModel::Sphere;
+    o.head_radius_mm = 22.0;
+    o.spacing = Eigen::Vector3d(1.0, 1.0, 1.5);
+    o.ras_storage = ras;
+    o.fov_cut = 0.25;
+    o.fov_face = phantom::faceDirection(face);
+    const phantom::Phantom p = phantom::makePhantom(o);
+    const Eigen::Vector3d u = o.fov_face, c = p.head.center;
+    const double plane = c.dot(u) + 22.0 - 0.25 * 22.0;
+    const imaging::ImageGeometry& g = p.ct.geometry;
+    double farthest = -1e9;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d idx((corner & 1) * (g.size[0] - 1), (corner >> 1 & 1) * (g.size[1] - 1), (corner >> 2 & 1) * (g.size[2] - 1));
+      farthest = std::max(farthest, g.toPhysical(idx).dot(u));
+    }
+    EXPECT_NEAR(farthest, plane, 1e-9) << face;
+    // The head's top along the face: beyond the last voxels.
+    const Eigen::Vector3d top_index = g.toIndex(c + 22.0 * u);
+    EXPECT_TRUE((top_index.array() < -0.5).any() || (top_index.array() > g.size.cast<double>().array() - 0.5).any()) << face;
+    // On the plane, on the head's axis: cancellous bone, the head cut open.
+    EXPECT_FLOAT_EQ(huAt(p, c + (plane - c.dot(u)) * u), float(o.cancellous_hu)) << face;
+    EXPECT_NEAR(p.truth["fov_cut"]["fraction_of_radius"].get<double>(), 0.25, 1e-6) << face;
+    EXPECT_EQ(vec3(p.truth["fov_cut"]["face"]), u) << face;
+    EXPECT_EQ(p.truth["grid"]["size"][0].get<int>(), g.size[0]);
+    EXPECT_EQ(vec3(p.truth["grid"]["origin_mm"]), g.origin);
+    EXPECT_EQ(p.femur.geometry.size, g.size);
+    EXPECT_EQ(p.femur.geometry.origin, g.origin);
+  }
+  EXPECT_THROW(phantom::faceDirection("+w"), UsageError);
+}
+
 }  // namespace
 }  // namespace articula

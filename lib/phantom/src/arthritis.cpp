@@ -1,5 +1,7 @@
 #include "arthritis.hpp"
 
+#include "surface_search.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -8,7 +10,6 @@
 
 #include <Eigen/Geometry>
 
-#include "articula/geometry/fibonacci.hpp"
 
 namespace articula::phantom {
 
@@ -35,65 +36,6 @@ double NarrowGap::weight(const Vector3d& from_head_centre) const {
 
 namespace detail {
 namespace {
-
-using Inside = std::function<bool(const Vector3d&)>;
-
-/// Distance from c to the boundary of a star-shaped solid along unit d, by
-/// bisection on `inside` (c inside, c + reach * d outside).
-double along(const Inside& inside, const Vector3d& c, const Vector3d& d, double reach, double tolerance = 1e-9) {
-  double lo = 0, hi = reach;
-  while (hi - lo > tolerance) (inside(c + 0.5 * (lo + hi) * d) ? lo : hi) = 0.5 * (lo + hi);
-  return 0.5 * (lo + hi);
-}
-
-/// A unit vector perpendicular to u.
-Vector3d perpendicular(const Vector3d& u) {
-  const Vector3d helper = std::abs(u.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
-  return u.cross(helper).normalized();
-}
-
-/// The point of the model surface farthest along u (its support point), by
-/// a pattern search over directions from the centre (the heads are convex).
-Vector3d support(const Inside& model, const Vector3d& c, const Vector3d& u, double reach) {
-  const auto point = [&](const Vector3d& d) { return c + along(model, c, d, reach) * d; };
-  const Vector3d e1 = perpendicular(u), e2 = u.cross(e1);
-  Vector3d best_d = u;
-  double best = (point(u) - c).dot(u);
-  for (double step = 0.2; step > 1e-7; step *= 0.5) {
-    for (bool improved = true; improved;) {
-      improved = false;
-      for (const Vector3d& e : {Vector3d(e1), Vector3d(-e1), Vector3d(e2), Vector3d(-e2)}) {
-        const Vector3d d = (best_d + step * e).normalized();
-        const double v = (point(d) - c).dot(u);
-        if (v > best + 1e-12) best = v, best_d = d, improved = true;
-      }
-    }
-  }
-  return point(best_d);
-}
-
-/// Area (mm^2) of the model surface where `in_region` holds, over the
-/// directions from the centre within the cone cos >= cos_limit about `axis`:
-/// a Fibonacci lattice of solid angles, each worth t^2 / (n . d) of surface.
-double modelArea(const geometry::PosedSurface& head, const Vector3d& c, double reach, const Vector3d& axis,
-                 double cos_limit, const Inside& in_region) {
-  const Inside model = [&head](const Vector3d& x) { return head.value(x) < 0; };
-  constexpr int kDirections = 200000;
-  const double solid_angle = 4.0 * M_PI / kDirections;
-  // The lattice about +z, turned onto the axis.
-  const Eigen::Matrix3d turn = Eigen::Quaterniond::FromTwoVectors(Vector3d::UnitZ(), axis).toRotationMatrix();
-  double area = 0;
-  for (int i = 0; i < kDirections; ++i) {
-    const Vector3d d = turn * geometry::fibonacciDirection(i, kDirections);
-    if (d.dot(axis) < cos_limit) continue;
-    const double t = along(model, c, d, reach, 1e-7);
-    const Vector3d q = c + t * d;
-    if (!in_region(q)) continue;
-    const Vector3d n = head.evaluate(q, 1).gradient.normalized();
-    area += t * t / std::max(n.dot(d), 1e-3) * solid_angle;
-  }
-  return area;
-}
 
 nlohmann::json vec(const Vector3d& v) { return {v[0], v[1], v[2]}; }
 Vector3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }

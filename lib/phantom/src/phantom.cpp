@@ -14,7 +14,9 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
+#include "artefacts.hpp"
 #include "arthritis.hpp"
+#include "surface_search.hpp"
 
 namespace articula::phantom {
 namespace {
@@ -177,34 +179,6 @@ struct Anatomy {
   }
 };
 
-/// Separable Gaussian blur of an i-fastest buffer, sigma in mm per axis;
-/// hand-written so that this module stays free of ITK.
-void blur(imaging::Volume& v, double sigma_mm) {
-  const imaging::ImageGeometry& g = v.geometry;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double s = sigma_mm / g.spacing[axis];
-    if (s < 0.1) continue;
-    const int r = static_cast<int>(std::ceil(3 * s));
-    std::vector<double> w(static_cast<size_t>(2 * r + 1));
-    double sum = 0;
-    for (int t = -r; t <= r; ++t) sum += w[static_cast<size_t>(t + r)] = std::exp(-0.5 * t * t / (s * s));
-    for (double& x : w) x /= sum;
-    const long long stride = axis == 0 ? 1 : axis == 1 ? g.size[0] : static_cast<long long>(g.size[0]) * g.size[1];
-    const int n = g.size[axis];
-    std::vector<float> line(static_cast<size_t>(n));
-    for (long long start = 0; start < g.voxelCount(); ++start) {
-      // Visit each line once, from its first voxel.
-      if ((start / stride) % n != 0) continue;
-      for (int t = 0; t < n; ++t) line[static_cast<size_t>(t)] = v.voxels[static_cast<size_t>(start + t * stride)];
-      for (int t = 0; t < n; ++t) {
-        double acc = 0;
-        for (int q = -r; q <= r; ++q) acc += w[static_cast<size_t>(q + r)] * line[static_cast<size_t>(std::clamp(t + q, 0, n - 1))];
-        v.voxels[static_cast<size_t>(start + t * stride)] = static_cast<float>(acc);
-      }
-    }
-  }
-}
-
 nlohmann::json vec(const Vector3d& v) { return {v[0], v[1], v[2]}; }
 
 /// Draws one head (the order of draws is that of the original single-hip
@@ -279,6 +253,42 @@ HipAnatomy makeHip(const PhantomOptions& o, const geometry::ShapeParameters& p, 
   h.max_reach = h.rmax + 1.5 * outer + 10.0;
   h.exact_depth = o.exact_depth;
   return h;
+}
+
+/// Where a clipped field of view ends: the voxel centres along index axis
+/// `axis` beyond `plane` (a coordinate along the face's direction u) go.
+struct FovCrop {
+  Vector3d u;
+  int axis = 2;
+  double plane = 0, head_extent = 0, r0 = 0;  // head_extent: the head's support coordinate along u
+};
+
+/// Plans the crop for the requested head and moves the grid along the face's
+/// axis (by under a voxel) so that a layer of voxel centres lies on the plane.
+FovCrop planFovCrop(const PhantomOptions& o, const HipAnatomy& h, imaging::ImageGeometry& g) {
+  FovCrop crop;
+  crop.u = o.fov_face;
+  crop.r0 = h.r0;
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(g.direction.col(a).dot(crop.u)) > 0.5) crop.axis = a;
+  const detail::Inside model = [&h](const Vector3d& x) { return h.head->value(x) < 0; };
+  crop.head_extent = detail::support(model, h.center, crop.u, 2.0 * h.rmax).dot(crop.u);
+  crop.plane = crop.head_extent - o.fov_cut * h.r0;
+  const double step = g.direction.col(crop.axis).dot(crop.u) * g.spacing[crop.axis];  // along u per index
+  const double from_origin = crop.plane - g.origin.dot(crop.u);
+  g.origin += (from_origin - step * std::round(from_origin / step)) * crop.u;
+  return crop;
+}
+
+/// The volume and the label with the voxels beyond the crop's plane removed.
+void applyFovCrop(const FovCrop& crop, Phantom& out) {
+  const imaging::ImageGeometry& g = out.ct.geometry;
+  const double step = g.direction.col(crop.axis).dot(crop.u) * g.spacing[crop.axis];
+  const int at = static_cast<int>(std::lround((crop.plane - g.origin.dot(crop.u)) / step));
+  const int last = g.size[crop.axis] - 1;
+  const int lo = step > 0 ? 0 : std::clamp(at, 0, last), hi = step > 0 ? std::clamp(at, 0, last) : last;
+  out.ct = detail::cropAxis(out.ct, crop.axis, lo, hi);
+  out.femur = detail::cropAxis(out.femur, crop.axis, lo, hi);
 }
 
 nlohmann::json hipTruth(const Hip& hip, const PhantomOptions& o) {
@@ -374,6 +384,19 @@ void PhantomOptions::validate() const {
   if (!(osteophytes_mm >= 0 && osteophytes_mm <= 6)) throw UsageError("phantom --osteophytes: expected 0 to 6 mm");
   if (!(narrow_gap_mm == 0 || (narrow_gap_mm >= 0.3 && narrow_gap_mm < gap_mm)))
     throw UsageError("phantom --narrow-gap: expected 0.3 mm to less than the joint's --gap");
+  if (fov_cut >= 0 && !(fov_cut <= 0.9)) throw UsageError("phantom --fov-cut: expected 0 to 0.9 of the radius");
+  if (fov_cut >= 0 && !(std::abs(fov_face.norm() - 1) < 1e-9 && fov_face.cwiseAbs().maxCoeff() > 1 - 1e-9))
+    throw UsageError("phantom --fov-face: expected a unit axis direction");
+}
+
+Vector3d faceDirection(const std::string& face) {
+  static const std::vector<std::pair<std::string, Vector3d>> faces = {
+      {"+x", Vector3d::UnitX()}, {"-x", -Vector3d::UnitX()}, {"+y", Vector3d::UnitY()}, {"-y", -Vector3d::UnitY()},
+      {"+z", Vector3d::UnitZ()}, {"-z", -Vector3d::UnitZ()}, {"L", Vector3d::UnitX()},  {"R", -Vector3d::UnitX()},
+      {"P", Vector3d::UnitY()},  {"A", -Vector3d::UnitY()}, {"S", Vector3d::UnitZ()},  {"I", -Vector3d::UnitZ()}};
+  for (const auto& [name, u] : faces)
+    if (face == name) return u;
+  throw UsageError("--fov-face '" + face + "': expected +x, -x, +y, -y, +z, -z (or L, R, P, A, S, I)");
 }
 
 Phantom makePhantom(const PhantomOptions& o) {
@@ -437,6 +460,8 @@ Phantom makePhantom(const PhantomOptions& o) {
   } else {
     g.origin = lo;
   }
+  std::optional<FovCrop> crop;
+  if (o.fov_cut >= 0) crop = planFovCrop(o, a.hips[0], g);
 
   Phantom out;
   for (const HipAnatomy& h : a.hips) out.hips.push_back(h.truth);
@@ -467,10 +492,11 @@ Phantom makePhantom(const PhantomOptions& o) {
         out.ct.at(i, j, k) = static_cast<float>(value);
         out.femur.at(i, j, k) = static_cast<std::uint8_t>(label);
       }
-  blur(out.ct, o.blur_mm);
+  detail::blur(out.ct, Vector3d::Constant(o.blur_mm));
   std::normal_distribution<double> noise(0.0, o.noise_hu);
   if (o.noise_hu > 0)
     for (float& v : out.ct.voxels) v += static_cast<float>(noise(rng));
+  if (crop) applyFovCrop(*crop, out);
 
   // Top level: the requested side's head, as in the single-hip phantom; `hips`: every head.
   out.truth = hipTruth(out.hips[0], o);
@@ -494,13 +520,22 @@ Phantom makePhantom(const PhantomOptions& o) {
       {"noise_hu", o.noise_hu},
       {"blur_mm", o.blur_mm},
       {"grid",
-       {{"size", {g.size[0], g.size[1], g.size[2]}},
+       {{"size", {out.ct.geometry.size[0], out.ct.geometry.size[1], out.ct.geometry.size[2]}},
         {"spacing_mm", vec(g.spacing)},
-        {"origin_mm", vec(g.origin)},
+        {"origin_mm", vec(out.ct.geometry.origin)},
         {"direction_row_major",
          {g.direction(0, 0), g.direction(0, 1), g.direction(0, 2), g.direction(1, 0), g.direction(1, 1),
           g.direction(1, 2), g.direction(2, 0), g.direction(2, 1), g.direction(2, 2)}}}},
   });
+  if (crop) {
+    const double beyond = crop->head_extent - crop->plane;
+    out.truth["fov_cut"] = {{"face", vec(crop->u)},
+                            {"fraction_of_radius", beyond / crop->r0},
+                            {"head_beyond_mm", beyond},
+                            {"radius_mm", crop->r0},
+                            {"plane_mm", crop->plane},
+                            {"head_extent_mm", crop->head_extent}};
+  }
   return out;
 }
 

@@ -19,6 +19,7 @@
 // a joint space narrowed over a superior patch), recorded in truth.json as
 // departures of the true articular surface from the head's model.
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -90,6 +91,14 @@ struct PhantomOptions {
   double narrow_gap_mm = 0.0;
   double cyst_hu = 20.0;  // fluid and fibrous tissue
 
+  /// A field of view that clips the requested side's head: the stored grid
+  /// ends (its last voxel centres) at a plane across fov_face (a unit LPS
+  /// axis: +x left, -x right, +y posterior, -y anterior, +z superior, -z
+  /// inferior), the head reaching fov_cut x its mean radius beyond it (0:
+  /// tangent). Negative: the whole field.
+  double fov_cut = -1.0;
+  Eigen::Vector3d fov_face = Eigen::Vector3d::UnitZ();
+
   /// Osteoporotic bone: cortex 0.8 mm at 700 HU, cancellous 190 +- 90 HU.
   void makeOsteoporotic();
   /// Throws UsageError naming the first invalid option.
@@ -159,6 +168,10 @@ struct Phantom {
   std::vector<Hip> hips;              // the requested side first
   nlohmann::json truth;               // everything above, for truth.json
 };
+
+/// The unit LPS direction of a face of the field of view: +x, -x, +y, -y,
+/// +z, -z, or the patient's L, R, P, A, S, I; throws UsageError otherwise.
+Eigen::Vector3d faceDirection(const std::string& face);
 
 /// Builds the phantom; deterministic for a given options.seed.
 Phantom makePhantom(const PhantomOptions& options);
