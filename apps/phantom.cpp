@@ -85,6 +85,12 @@ class PhantomCommand : public cli::Command {
                    "The face of the field of view that --fov-cut moves in: +x, -x, +y, -y, +z, -z (LPS: left, right, "
                    "posterior, anterior, superior, inferior; or L, R, P, A, S, I)")
         ->capture_default_str();
+    app.add_option("--metal", metal_,
+                   "Metal on the --side femur: screw (a 6.5 mm lag screw along the neck into the head, as after a "
+                   "fixed neck fracture) or stem (a 12 mm stem in the shaft), at 8000 HU clipped to the scanner's "
+                   "3071, with streaks (bright and dark lines through the metal in each slice) and dark bands "
+                   "along and between its parts")
+        ->check(CLI::IsMember({"screw", "stem"}));
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
@@ -110,6 +116,7 @@ class PhantomCommand : public cli::Command {
     o.osteophytes_mm = options_.osteophytes_mm;
     o.cysts = options_.cysts;
     o.narrow_gap_mm = options_.narrow_gap_mm;
+    if (!metal_.empty()) o.metal = phantom::metalFromName(metal_);
     if (fov_cut_->count()) {
       if (!(fov_cut_value_ >= 0)) throw UsageError("--fov-cut: expected a fraction of the radius from 0 to 0.9");
       o.fov_cut = fov_cut_value_;
@@ -184,7 +191,7 @@ class PhantomCommand : public cli::Command {
   std::string socket_ = "congruent";
   double socket_cortical_hu_ = 0, socket_cancellous_hu_ = 0;
   double fov_cut_value_ = 0;
-  std::string fov_face_ = "+z";
+  std::string fov_face_ = "+z", metal_;
   phantom::PhantomOptions options_;  // holds the parsed values of the bone and socket options
   CLI::Option *radius_option_ = nullptr, *cortical_hu_ = nullptr, *cancellous_hu_ = nullptr, *cortical_mm_ = nullptr, *variation_ = nullptr,
               *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr, *fov_cut_ = nullptr;

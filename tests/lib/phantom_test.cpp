@@ -2,6 +2,7 @@
 // femur truth label, and deterministic output; the options of the wider
 // phantom (radius, gap, socket, osteoporotic bone, fovea, both hips) checked
 // voxel by voxel against the exact distance to the true head.
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -542,6 +543,70 @@ TEST(Phantom, FieldOfViewCutEndsTheGridInsideTheHead) {
     EXPECT_EQ(p.femur.geometry.origin, g.origin);
   }
   EXPECT_THROW(phantom::faceDirection("+w"), UsageError);
+}
+
+// Metal: a screw along the neck axis from under the dome, a stem down the
+// shaft; dense (above 2,500 HU along the axis, clipped at 3,071); streaks
+// in the slices through it (soft tissue far from the metal off by hundreds
+// of HU) and none elsewhere (slices without metal are the plain phantom's,
+// noise included).
+TEST(Phantom, MetalScrewAndStemWithStreaks) {
+  for (const auto metal : {phantom::PhantomOptions::Metal::Screw, phantom::PhantomOptions::Metal::Stem}) {
+    phantom::PhantomOptions o;
+    o.seed = 19;
+    o.model = geometry::ShapeModel::Sphere;
+    o.head_radius_mm = 22.0;
+    o.spacing = Eigen::Vector3d(1.0, 1.0, 2.0);
+    const phantom::Phantom plain = phantom::makePhantom(o);
+    o.metal = metal;
+    const phantom::Phantom p = phantom::makePhantom(o);
+    const Eigen::Vector3d from = vec3(p.truth["metal"]["from_mm"]), to = vec3(p.truth["metal"]["to_mm"]);
+    const Eigen::Vector3d c = p.head.center;
+    if (metal == phantom::PhantomOptions::Metal::Screw) {
+      EXPECT_EQ(p.truth["metal"]["kind"], "screw");
+      EXPECT_NEAR((from - c).normalized().dot(-p.neck_axis), 1.0, 1e-9);  // into the head, opposite the neck
+      EXPECT_NEAR((to - c).normalized().dot(p.neck_axis), 1.0, 1e-9);
+      EXPECT_NEAR((from - c).norm(), 22.0 - 6.0, 1e-6);                  // 6 mm under the dome
+    } else {
+      EXPECT_EQ(p.truth["metal"]["kind"], "stem");
+      EXPECT_NEAR((to - from).normalized().z(), -1.0, 1e-12);
+    }
+    int dense = 0;
+    for (double t = 0.05; t <= 0.95; t += 0.05) {
+      const Eigen::Vector3d idx = p.ct.geometry.toIndex(from + t * (to - from));
+      if ((idx.array() < 0).any() || (idx.array() > p.ct.geometry.size.cast<double>().array() - 1).any()) continue;  // a stem runs on beyond the field
+      EXPECT_GT(huAt(p, from + t * (to - from)), 2500.0) << t;
+      ++dense;
+    }
+    EXPECT_GE(dense, 6);
+    const auto [lowest, highest] = std::minmax_element(p.ct.voxels.begin(), p.ct.voxels.end());
+    EXPECT_EQ(*highest, 3071.0f);
+    EXPECT_GE(*lowest, -1024.0f);
+    // Per slice: streaks where the slice holds metal, the plain phantom elsewhere.
+    const imaging::ImageGeometry& g = p.ct.geometry;
+    int streaked = 0, untouched = 0;
+    for (int k = 0; k < g.size[2]; ++k) {
+      const double z = g.toPhysical(Eigen::Vector3d(0, 0, k)).z();
+      const bool has_metal = z > std::min(from.z(), to.z()) + 4 && z < std::max(from.z(), to.z()) - 4;
+      const bool clear = z < std::min(from.z(), to.z()) - 8 || z > std::max(from.z(), to.z()) + 8;  // beyond the blur
+      int off = 0;
+      bool same = true;
+      for (int j = 0; j < g.size[1]; ++j)
+        for (int i = 0; i < g.size[0]; ++i) {
+          same = same && p.ct.at(i, j, k) == plain.ct.at(i, j, k);
+          const Eigen::Vector3d x = g.toPhysical(Eigen::Vector3d(i, j, k));
+          if (plain.femur.at(i, j, k) == 0 && (x - c).norm() > 45 && std::abs(p.ct.at(i, j, k) - plain.ct.at(i, j, k)) > 100) ++off;
+        }
+      if (has_metal) streaked += off > 20;
+      if (clear) {
+        EXPECT_TRUE(same) << "slice " << k;
+        ++untouched;
+      }
+    }
+    EXPECT_GT(streaked, 5);
+    EXPECT_GT(untouched, 5);
+  }
+  EXPECT_THROW(phantom::metalFromName("plate"), UsageError);
 }
 
 }  // namespace

@@ -111,6 +111,7 @@ struct Anatomy {
   double socket_half_angle_cos = std::cos(80.0 * M_PI / 180.0);
   Vector3d wave_phase = Vector3d::Zero();
   std::vector<Cyst> cysts;  // of the requested side's head
+  std::vector<Cylinder> metal;
   const PhantomOptions* o = nullptr;
 
   /// Depth inside a hip's acetabulum: a shell of the wall's thickness,
@@ -143,9 +144,26 @@ struct Anatomy {
     return base + o->cancellous_variation_hu * std::sin(w[0]) * std::sin(w[1]) * std::sin(w[2]);
   }
 
-  /// HU at x and the distance to the nearest tissue interface (mm); `femur`
-  /// gets the label of the femur containing x (0: none).
+  /// Depth inside the metal (positive inside, mm).
+  double metalDepth(const Vector3d& x) const {
+    double depth = -std::numeric_limits<double>::infinity();
+    for (const Cylinder& c : metal) depth = std::max(depth, c.depth(x));
+    return depth;
+  }
+
+  /// HU at x and the distance to the nearest interface: the tissues, with
+  /// what lies in them (metal).
   double hu(const Vector3d& x, double& interface, int* femur_label = nullptr) const {
+    const double tissue = tissueHu(x, interface, femur_label);
+    if (metal.empty()) return tissue;
+    const double depth = metalDepth(x);
+    interface = std::min(interface, std::fabs(depth));
+    return depth > 0 ? o->metal_hu : tissue;
+  }
+
+  /// The tissues' HU at x and the distance to the nearest tissue interface
+  /// (mm); `femur` gets the label of the femur containing x (0: none).
+  double tissueHu(const Vector3d& x, double& interface, int* femur_label = nullptr) const {
     double femur = -std::numeric_limits<double>::infinity(), pelvis = femur, clearance = -femur;
     for (size_t n = 0; n < hips.size(); ++n) {
       const HipAnatomy& h = hips[n];
@@ -389,6 +407,13 @@ void PhantomOptions::validate() const {
     throw UsageError("phantom --fov-face: expected a unit axis direction");
 }
 
+PhantomOptions::Metal metalFromName(const std::string& name) {
+  if (name == "none") return PhantomOptions::Metal::None;
+  if (name == "screw") return PhantomOptions::Metal::Screw;
+  if (name == "stem") return PhantomOptions::Metal::Stem;
+  throw UsageError("--metal '" + name + "': expected screw or stem");
+}
+
 Vector3d faceDirection(const std::string& face) {
   static const std::vector<std::pair<std::string, Vector3d>> faces = {
       {"+x", Vector3d::UnitX()}, {"-x", -Vector3d::UnitX()}, {"+y", Vector3d::UnitY()}, {"-y", -Vector3d::UnitY()},
@@ -421,6 +446,15 @@ Phantom makePhantom(const PhantomOptions& o) {
   HipAnatomy& requested = a.hips[0];
   detail::addArthritis(o, *requested.head, requested.r0, requested.neck_radius, requested.truth);
   a.cysts = requested.truth.cysts;
+  if (o.metal == PhantomOptions::Metal::Screw) {
+    // A lag screw along the neck from beyond the lateral cortex to 6 mm under the dome.
+    const Vector3d axis = requested.truth.neck_axis;
+    const detail::Inside model = [&requested](const Vector3d& x) { return requested.head->value(x) < 0; };
+    const double to_dome = detail::along(model, requested.center, -axis, 2.0 * requested.rmax);
+    a.metal.push_back({requested.center - (to_dome - 6.0) * axis, requested.center + (1.9 * requested.r0 + 30.0) * axis, 3.25});
+  } else if (o.metal == PhantomOptions::Metal::Stem) {
+    a.metal.push_back({requested.shaft_top + Vector3d(0, 0, 5.0), requested.shaft_top - Vector3d(0, 0, 140.0), 6.0});
+  }
   if (o.cancellous_variation_hu > 0) a.wave_phase = Vector3d(uniform(0, 2 * M_PI), uniform(0, 2 * M_PI), uniform(0, 2 * M_PI));
 
   // The grid: head, socket and pelvis medially, neck and shaft laterally.
@@ -493,9 +527,12 @@ Phantom makePhantom(const PhantomOptions& o) {
         out.femur.at(i, j, k) = static_cast<std::uint8_t>(label);
       }
   detail::blur(out.ct, Vector3d::Constant(o.blur_mm));
+  if (!a.metal.empty())
+    detail::addMetalStreaks(out.ct, [&a](const Vector3d& x) { return a.metalDepth(x) > 0; }, o.seed ^ 0x3e7a1c5ULL);
   std::normal_distribution<double> noise(0.0, o.noise_hu);
   if (o.noise_hu > 0)
     for (float& v : out.ct.voxels) v += static_cast<float>(noise(rng));
+  if (!a.metal.empty()) detail::clipToScannerRange(out.ct);
   if (crop) applyFovCrop(*crop, out);
 
   // Top level: the requested side's head, as in the single-hip phantom; `hips`: every head.
@@ -527,6 +564,15 @@ Phantom makePhantom(const PhantomOptions& o) {
          {g.direction(0, 0), g.direction(0, 1), g.direction(0, 2), g.direction(1, 0), g.direction(1, 1),
           g.direction(1, 2), g.direction(2, 0), g.direction(2, 1), g.direction(2, 2)}}}},
   });
+  if (!a.metal.empty()) {
+    const Cylinder& m = a.metal.front();
+    out.truth["metal"] = {{"kind", o.metal == PhantomOptions::Metal::Screw ? "screw" : "stem"},
+                          {"from_mm", vec(m.a)},
+                          {"to_mm", vec(m.b)},
+                          {"radius_mm", m.radius},
+                          {"hu", o.metal_hu},
+                          {"clipped_to_hu", {-1024, 3071}}};
+  }
   if (crop) {
     const double beyond = crop->head_extent - crop->plane;
     out.truth["fov_cut"] = {{"face", vec(crop->u)},

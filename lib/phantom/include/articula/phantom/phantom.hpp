@@ -99,6 +99,16 @@ struct PhantomOptions {
   double fov_cut = -1.0;
   Eigen::Vector3d fov_face = Eigen::Vector3d::UnitZ();
 
+  /// Metal on the requested side: a lag screw (6.5 mm) along the femoral
+  /// neck into the head, or a stem (12 mm) in the femoral shaft, at
+  /// metal_hu; with streaks (seeded bright and dark lines through the metal
+  /// in each axial slice, fading with distance) and dark bands along the
+  /// metal's long chords and between its parts; the CT then clipped to the
+  /// scanner's range [-1024, 3071] HU.
+  enum class Metal { None, Screw, Stem };
+  Metal metal = Metal::None;
+  double metal_hu = 8000.0;
+
   /// Osteoporotic bone: cortex 0.8 mm at 700 HU, cancellous 190 +- 90 HU.
   void makeOsteoporotic();
   /// Throws UsageError naming the first invalid option.
@@ -168,6 +178,9 @@ struct Phantom {
   std::vector<Hip> hips;              // the requested side first
   nlohmann::json truth;               // everything above, for truth.json
 };
+
+/// Metal::None, Screw or Stem from "none", "screw", "stem"; throws UsageError otherwise.
+PhantomOptions::Metal metalFromName(const std::string& name);
 
 /// The unit LPS direction of a face of the field of view: +x, -x, +y, -y,
 /// +z, -z, or the patient's L, R, P, A, S, I; throws UsageError otherwise.
