@@ -91,6 +91,21 @@ class PhantomCommand : public cli::Command {
                    "3071, with streaks (bright and dark lines through the metal in each slice) and dark bands "
                    "along and between its parts")
         ->check(CLI::IsMember({"screw", "stem"}));
+    app.add_option("--kernel", kernel_,
+                   "Reconstruction kernel, within the slices: standard; soft (a further 0.6 mm Gaussian: smoother "
+                   "edges, fainter noise, as a soft-tissue kernel); sharp (edge enhancement with an overshoot at each "
+                   "edge and about twice the noise, correlated, as a bone kernel)")
+        ->check(CLI::IsMember({"standard", "soft", "sharp"}))->capture_default_str();
+    app.add_flag("--contrast-vessel", options_.contrast_vessel,
+                 "A 6 mm vessel filled with contrast (300 HU) running anterior-medial to the head, 5 mm off it, as "
+                 "the femoral artery in a CT angiogram");
+    app.add_flag("--table", options_.table,
+                 "The patient table: a curved slab (700 HU, 6 mm) under the patient's back with air beyond it, in "
+                 "the field of view (the grid grows 26 mm posteriorly)");
+    app.add_option("--slice-thickness", options_.slice_thickness_mm,
+                   "Slices thicker than their spacing (mm): each slice the mean over a box this wide across the "
+                   "slices, as a scan reconstructed at 3 mm and stored every 1.5 mm (0: the z spacing)")
+        ->capture_default_str();
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
@@ -117,6 +132,10 @@ class PhantomCommand : public cli::Command {
     o.cysts = options_.cysts;
     o.narrow_gap_mm = options_.narrow_gap_mm;
     if (!metal_.empty()) o.metal = phantom::metalFromName(metal_);
+    o.kernel = phantom::kernelFromName(kernel_);
+    o.contrast_vessel = options_.contrast_vessel;
+    o.table = options_.table;
+    o.slice_thickness_mm = options_.slice_thickness_mm;
     if (fov_cut_->count()) {
       if (!(fov_cut_value_ >= 0)) throw UsageError("--fov-cut: expected a fraction of the radius from 0 to 0.9");
       o.fov_cut = fov_cut_value_;
@@ -191,7 +210,7 @@ class PhantomCommand : public cli::Command {
   std::string socket_ = "congruent";
   double socket_cortical_hu_ = 0, socket_cancellous_hu_ = 0;
   double fov_cut_value_ = 0;
-  std::string fov_face_ = "+z", metal_;
+  std::string fov_face_ = "+z", metal_, kernel_ = "standard";
   phantom::PhantomOptions options_;  // holds the parsed values of the bone and socket options
   CLI::Option *radius_option_ = nullptr, *cortical_hu_ = nullptr, *cancellous_hu_ = nullptr, *cortical_mm_ = nullptr, *variation_ = nullptr,
               *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr, *fov_cut_ = nullptr;

@@ -1,7 +1,9 @@
 // Phantom: tissues where the truth puts them, the model varied by seed, the
 // femur truth label, and deterministic output; the options of the wider
 // phantom (radius, gap, socket, osteoporotic bone, fovea, both hips) checked
-// voxel by voxel against the exact distance to the true head.
+// voxel by voxel against the exact distance to the true head; the clinical
+// options (arthritis, a clipped field of view, metal, kernels, a contrast
+// vessel, the table, thick slices) against their analytic geometry.
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -607,6 +609,143 @@ TEST(Phantom, MetalScrewAndStemWithStreaks) {
     EXPECT_GT(untouched, 5);
   }
   EXPECT_THROW(phantom::metalFromName("plate"), UsageError);
+}
+
+// Noise in a block of soft tissue far from bone: its standard deviation and
+// the correlation of in-plane neighbours.
+std::pair<double, double> softTissueNoise(const phantom::Phantom& p) {
+  const imaging::ImageGeometry& g = p.ct.geometry;
+  const Eigen::Vector3d idx = g.toIndex(p.head.center + Eigen::Vector3d(0, -45, 0));  // anterior, in soft tissue
+  double sum = 0, sum2 = 0, cross = 0;
+  int n = 0;
+  for (int k = int(idx[2]) - 4; k <= int(idx[2]) + 4; ++k)
+    for (int j = int(idx[1]) - 3; j <= int(idx[1]) + 3; ++j)
+      for (int i = int(idx[0]) - 8; i <= int(idx[0]) + 8; ++i) {
+        const double v = p.ct.at(i, j, k) - 40.0, w = p.ct.at(i + 1, j, k) - 40.0;
+        sum += v, sum2 += v * v, cross += v * w, ++n;
+      }
+  const double var = sum2 / n - (sum / n) * (sum / n);
+  return {std::sqrt(var), (cross / n - (sum / n) * (sum / n)) / var};
+}
+
+// The kernels: soft halves the noise and correlates neighbours; sharp
+// raises it, and overshoots each edge (noise-free: HU above the cortex's
+// and below the soft tissue's beside the head's surface, which the standard
+// kernel never leaves).
+TEST(Phantom, KernelsSmoothOrSharpenEdgesAndNoise) {
+  phantom::PhantomOptions o;
+  o.seed = 20;
+  o.model = geometry::ShapeModel::Sphere;
+  o.head_radius_mm = 22.0;
+  o.spacing = Eigen::Vector3d(1.0, 1.0, 1.5);
+  o.cortical_mm = 2.5;
+  const auto [standard_sd, standard_corr] = softTissueNoise(phantom::makePhantom(o));
+  o.kernel = phantom::PhantomOptions::Kernel::Soft;
+  const auto [soft_sd, soft_corr] = softTissueNoise(phantom::makePhantom(o));
+  o.kernel = phantom::PhantomOptions::Kernel::Sharp;
+  const phantom::Phantom sharp = phantom::makePhantom(o);
+  const auto [sharp_sd, sharp_corr] = softTissueNoise(sharp);
+  EXPECT_NEAR(standard_sd, 20.0, 2.5);
+  EXPECT_LT(std::abs(standard_corr), 0.1);
+  EXPECT_LT(soft_sd, 0.6 * standard_sd);
+  EXPECT_GT(soft_corr, 0.3);
+  EXPECT_GT(sharp_sd, 1.6 * standard_sd);
+  EXPECT_GT(std::abs(sharp_corr), 0.1);
+  EXPECT_EQ(sharp.truth["kernel"], "sharp");
+  // Noise-free: the range along in-plane rays across the head's surface.
+  o.noise_hu = 0;
+  for (const auto kernel : {phantom::PhantomOptions::Kernel::Standard, phantom::PhantomOptions::Kernel::Sharp}) {
+    o.kernel = kernel;
+    const phantom::Phantom p = phantom::makePhantom(o);
+    double highest = -1e9, lowest = 1e9;
+    for (double angle = 0; angle < 2 * M_PI; angle += 0.2) {
+      const Eigen::Vector3d d(std::cos(angle), std::sin(angle), 0);
+      if (d.dot(p.hips[0].socket_axis) > 0) continue;  // away from the socket
+      for (double t = 18.0; t <= 26.0; t += 0.2) {
+        const double v = huAt(p, p.head.center + t * d);
+        highest = std::max(highest, v);
+        if (t > 22.0) lowest = std::min(lowest, v);
+      }
+    }
+    if (kernel == phantom::PhantomOptions::Kernel::Sharp) {
+      EXPECT_GT(highest, o.cortical_hu + 100);
+      EXPECT_LT(lowest, o.soft_tissue_hu - 100);
+    } else {
+      EXPECT_LE(highest, o.cortical_hu + 1);
+      EXPECT_GE(lowest, o.soft_tissue_hu - 1);
+    }
+  }
+}
+
+// A contrast vessel anterior-medial to the head at 300 HU, its wall 5 mm off
+// the head's bounding sphere; a table behind the body, air beyond it.
+TEST(Phantom, ContrastVesselAndTable) {
+  phantom::PhantomOptions o = clean(21);
+  o.model = geometry::ShapeModel::Sphere;
+  o.head_radius_mm = 22.0;
+  o.contrast_vessel = true;
+  o.table = true;
+  const phantom::Phantom p = phantom::makePhantom(o);
+  const Eigen::Vector3d c = p.head.center;
+  const Eigen::Vector3d at = vec3(p.truth["contrast_vessel"]["point_mm"]), along = vec3(p.truth["contrast_vessel"]["direction"]);
+  // At the head's level: the vessel's axis 22 + 5 + 3 mm from the centre, anterior (-y) and medial (+x for a right hip).
+  EXPECT_NEAR((at - c).norm(), 30.0, 1e-9);
+  EXPECT_LT((at - c).y(), -25.0);
+  EXPECT_GT((at - c).x(), 5.0);
+  for (double t = -30; t <= 0; t += 5) EXPECT_FLOAT_EQ(huAt(p, at + t * along), float(o.vessel_hu)) << t;  // above, the socket's bone stays
+  EXPECT_FLOAT_EQ(huAt(p, at + 4.0 * Eigen::Vector3d(0, -1, 0)), float(o.soft_tissue_hu));
+  // The table: the grid's posterior end holds its slab, then air.
+  const imaging::ImageGeometry& g = p.ct.geometry;
+  const double axis_y = p.truth["table"]["axis_xy_mm"][1].get<double>(), r = 400.0;
+  const double x = c.x(), top = axis_y + std::sqrt(r * r - x * x);  // the slab's inner surface at this x
+  EXPECT_FLOAT_EQ(huAt(p, Eigen::Vector3d(x, top + 3.0, c.z())), 700.0f);
+  EXPECT_FLOAT_EQ(huAt(p, Eigen::Vector3d(x, top + 12.0, c.z())), -1000.0f);
+  EXPECT_FLOAT_EQ(huAt(p, Eigen::Vector3d(x, top - 3.0, c.z())), float(o.soft_tissue_hu));
+  phantom::PhantomOptions plain = clean(21);
+  plain.model = o.model;
+  plain.head_radius_mm = o.head_radius_mm;
+  const double grown = (g.size[1] - phantom::makePhantom(plain).ct.geometry.size[1]) * g.spacing[1];
+  EXPECT_NEAR(grown, 26.0, 1.0);
+}
+
+// Thick slices: along the vertical through a sphere's centre, each slice is
+// the mean of the thin profile (head, gap, socket) over a box of the
+// thickness about it, as sampled by slices 4 times finer.
+TEST(Phantom, ThickSlicesAverageABoxAcrossTheSlices) {
+  phantom::PhantomOptions o = clean(22);
+  o.model = geometry::ShapeModel::Sphere;
+  o.head_radius_mm = 22.0;
+  o.spacing = Eigen::Vector3d(1.0, 1.0, 2.0);
+  o.slice_thickness_mm = 4.0;
+  const phantom::Phantom p = phantom::makePhantom(o);
+  const Eigen::Vector3d c = p.head.center;
+  const double top = c.z() + 22.0;
+  const auto thin = [&](double z) {  // the head's cortex and bone, the gap, the congruent socket's cortex and bone
+    const double d = z - top, gap = o.gap_mm, cortex = o.cortical_mm;
+    if (d > gap + cortex) return o.cancellous_hu;
+    if (d > gap) return o.cortical_hu;
+    if (d > 0) return o.soft_tissue_hu;
+    return d > -cortex ? o.cortical_hu : o.cancellous_hu;
+  };
+  const imaging::ImageGeometry& g = p.ct.geometry;
+  const Eigen::Vector3d idx = g.toIndex(c);
+  const int i = int(std::lround(idx[0])), j = int(std::lround(idx[1]));
+  int compared = 0;
+  for (int k = 0; k < g.size[2]; ++k) {
+    const Eigen::Vector3d x = g.toPhysical(Eigen::Vector3d(i, j, k));
+    if (std::abs(x.z() - top) > 6.0) continue;
+    // The box over the slices rendered 4 times finer (0.5 mm): the fine
+    // slices weighted by their overlap with it, 1/8 each and 1/16 at the ends.
+    double expected = 0;
+    for (int q = -4; q <= 4; ++q)
+      for (int n = 0; n < 1000; ++n)
+        expected += (std::abs(q) == 4 ? 1.0 / 16 : 1.0 / 8) * thin(x.z() + 0.5 * (q - 0.5 + (n + 0.5) / 1000)) / 1000;
+    EXPECT_NEAR(p.ct.at(i, j, k), expected, 20.0) << "z - top " << x.z() - top;  // partial volume: 3 samples across a fine slice
+    EXPECT_EQ(p.femur.at(i, j, k), (x - c).norm() < 22.0 ? 1 : 0);
+    ++compared;
+  }
+  EXPECT_GE(compared, 5);
+  EXPECT_EQ(p.truth["slice_thickness_mm"].get<double>(), 4.0);
 }
 
 }  // namespace

@@ -35,6 +35,12 @@ void blur(imaging::Volume& v, const Eigen::Vector3d& sigma_mm) {
   }
 }
 
+void sharpenInPlane(imaging::Volume& v, double sigma_mm, double gain) {
+  imaging::Volume smooth = v;
+  blur(smooth, Eigen::Vector3d(sigma_mm, sigma_mm, 0.0));
+  for (size_t n = 0; n < v.voxels.size(); ++n) v.voxels[n] += static_cast<float>(gain * (v.voxels[n] - smooth.voxels[n]));
+}
+
 namespace {
 
 /// A connected part of a slice's metal: its centroid, long axis, and the

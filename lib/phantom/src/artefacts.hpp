@@ -14,6 +14,10 @@ namespace articula::phantom::detail {
 /// axis (an axis whose sigma is under 0.1 voxel is left as it is).
 void blur(imaging::Volume& v, const Eigen::Vector3d& sigma_mm);
 
+/// Unsharp masking within the slices (index axes 0 and 1):
+/// v + gain (v - G_sigma v), an overshoot on either side of each edge.
+void sharpenInPlane(imaging::Volume& v, double sigma_mm, double gain);
+
 /// Metal artefacts, slice by slice across index axis 2 (axial slices):
 /// beam-hardening and photon-starvation streaks as a simple model, not a
 /// reconstruction. In each slice with metal (voxel centres where is_metal),

@@ -112,6 +112,11 @@ struct Anatomy {
   Vector3d wave_phase = Vector3d::Zero();
   std::vector<Cyst> cysts;  // of the requested side's head
   std::vector<Cylinder> metal;
+  std::optional<Cylinder> vessel;
+  /// The table's slab in the axial plane: radius to radius + thickness
+  /// from an axis along z through (x, y) = table_axis; air beyond.
+  std::optional<Eigen::Vector2d> table_axis;
+  double table_radius = 400.0, table_thickness = 6.0, table_hu = 700.0, air_hu = -1000.0;
   const PhantomOptions* o = nullptr;
 
   /// Depth inside a hip's acetabulum: a shell of the wall's thickness,
@@ -154,16 +159,33 @@ struct Anatomy {
   /// HU at x and the distance to the nearest interface: the tissues, with
   /// what lies in them (metal).
   double hu(const Vector3d& x, double& interface, int* femur_label = nullptr) const {
-    const double tissue = tissueHu(x, interface, femur_label);
-    if (metal.empty()) return tissue;
-    const double depth = metalDepth(x);
-    interface = std::min(interface, std::fabs(depth));
-    return depth > 0 ? o->metal_hu : tissue;
+    bool in_bone = false;
+    const double tissue = tissueHu(x, interface, femur_label, &in_bone);
+    if (metal.empty() && !vessel && !table_axis) return tissue;
+    double value = tissue;
+    if (table_axis) {
+      // Posterior of the body's back: the table's slab, then air.
+      const double r = (x.head<2>() - *table_axis).norm();
+      interface = std::min({interface, std::fabs(r - table_radius), std::fabs(r - table_radius - table_thickness)});
+      if (r > table_radius + table_thickness) return air_hu;
+      if (r > table_radius) return table_hu;
+    }
+    if (vessel) {
+      const double depth = vessel->depth(x);
+      interface = std::min(interface, std::fabs(depth));
+      if (depth > 0 && !in_bone) value = o->vessel_hu;
+    }
+    if (!metal.empty()) {
+      const double depth = metalDepth(x);
+      interface = std::min(interface, std::fabs(depth));
+      if (depth > 0) value = o->metal_hu;
+    }
+    return value;
   }
 
   /// The tissues' HU at x and the distance to the nearest tissue interface
   /// (mm); `femur` gets the label of the femur containing x (0: none).
-  double tissueHu(const Vector3d& x, double& interface, int* femur_label = nullptr) const {
+  double tissueHu(const Vector3d& x, double& interface, int* femur_label = nullptr, bool* in_bone = nullptr) const {
     double femur = -std::numeric_limits<double>::infinity(), pelvis = femur, clearance = -femur;
     for (size_t n = 0; n < hips.size(); ++n) {
       const HipAnatomy& h = hips[n];
@@ -182,6 +204,7 @@ struct Anatomy {
     const double cortex = o->cortical_mm;
     interface = std::min({std::fabs(femur), std::fabs(femur - cortex), std::fabs(pelvis), std::fabs(pelvis - cortex)});
     const double bone = std::max(femur, pelvis);
+    if (in_bone) *in_bone = bone > 0;
     if (bone <= 0) return o->soft_tissue_hu;
     if (femur >= pelvis) {
       // Subchondral cysts: fluid balls in the cancellous bone.
@@ -271,6 +294,70 @@ HipAnatomy makeHip(const PhantomOptions& o, const geometry::ShapeParameters& p, 
   h.max_reach = h.rmax + 1.5 * outer + 10.0;
   h.exact_depth = o.exact_depth;
   return h;
+}
+
+/// The tissues on grid g, each voxel the mean of 3 x 3 x 3 samples where an
+/// interface passes within half its diagonal (partial volume), and the femur
+/// label of its centre.
+void render(const Anatomy& a, const imaging::ImageGeometry& g, imaging::Volume& ct, imaging::Label& femur) {
+  ct.geometry = g;
+  ct.voxels.resize(static_cast<size_t>(g.voxelCount()));
+  femur.geometry = g;
+  femur.voxels.assign(ct.voxels.size(), 0);
+  const double half_diagonal = 0.5 * g.spacing.norm();
+  const int sub = 3;  // partial volume: 3 x 3 x 3 samples in voxels near an interface
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const Vector3d x = g.toPhysical(Vector3d(i, j, k));
+        double interface = 0;
+        int label = 0;
+        double value = a.hu(x, interface, &label);
+        if (interface < half_diagonal) {
+          value = 0;
+          double ignored = 0;
+          for (int c = 0; c < sub * sub * sub; ++c) {
+            const Vector3d offset((c % sub + 0.5) / sub - 0.5, (c / sub % sub + 0.5) / sub - 0.5, (c / (sub * sub) + 0.5) / sub - 0.5);
+            value += a.hu(g.toPhysical(Vector3d(i, j, k) + offset), ignored);
+          }
+          value /= sub * sub * sub;
+        }
+        ct.at(i, j, k) = static_cast<float>(value);
+        femur.at(i, j, k) = static_cast<std::uint8_t>(label);
+      }
+}
+
+/// Slices thicker than their spacing: the tissues rendered on slices m
+/// times finer (0.5 mm or a quarter of the thickness at most), each output
+/// slice their mean over a box `thickness` wide about it (the fine slices
+/// weighted by their overlap with the box); the label of its centre.
+void renderThickSlices(const Anatomy& a, const imaging::ImageGeometry& g, double thickness, imaging::Volume& ct,
+                       imaging::Label& femur) {
+  const int m = std::max(2, static_cast<int>(std::ceil(g.spacing[2] / std::min(0.5, 0.25 * thickness))));
+  const double fine_mm = g.spacing[2] / m, half = 0.5 * thickness / fine_mm;  // the box's half width in fine slices
+  const int pad = static_cast<int>(std::ceil(half)) + 1;
+  imaging::ImageGeometry fine = g;
+  fine.spacing[2] = fine_mm;
+  fine.size[2] = (g.size[2] - 1) * m + 1 + 2 * pad;
+  fine.origin = g.toPhysical(Vector3d(0, 0, -static_cast<double>(pad) / m));
+  imaging::Volume fine_ct;
+  imaging::Label fine_label;
+  render(a, fine, fine_ct, fine_label);
+  ct.geometry = g;
+  ct.voxels.assign(static_cast<size_t>(g.voxelCount()), 0.0f);
+  femur.geometry = g;
+  femur.voxels.assign(ct.voxels.size(), 0);
+  for (int k = 0; k < g.size[2]; ++k) {
+    const int centre = m * k + pad;
+    for (int q = -pad; q <= pad; ++q) {
+      const double w = std::max(0.0, std::min(q + 0.5, half) - std::max(q - 0.5, -half)) / (2.0 * half);
+      if (w <= 0) continue;
+      for (int j = 0; j < g.size[1]; ++j)
+        for (int i = 0; i < g.size[0]; ++i) ct.at(i, j, k) += static_cast<float>(w * fine_ct.at(i, j, centre + q));
+    }
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) femur.at(i, j, k) = fine_label.at(i, j, centre);
+  }
 }
 
 /// Where a clipped field of view ends: the voxel centres along index axis
@@ -402,6 +489,7 @@ void PhantomOptions::validate() const {
   if (!(osteophytes_mm >= 0 && osteophytes_mm <= 6)) throw UsageError("phantom --osteophytes: expected 0 to 6 mm");
   if (!(narrow_gap_mm == 0 || (narrow_gap_mm >= 0.3 && narrow_gap_mm < gap_mm)))
     throw UsageError("phantom --narrow-gap: expected 0.3 mm to less than the joint's --gap");
+  if (!(slice_thickness_mm >= 0 && slice_thickness_mm <= 10)) throw UsageError("phantom --slice-thickness: expected 0 to 10 mm");
   if (fov_cut >= 0 && !(fov_cut <= 0.9)) throw UsageError("phantom --fov-cut: expected 0 to 0.9 of the radius");
   if (fov_cut >= 0 && !(std::abs(fov_face.norm() - 1) < 1e-9 && fov_face.cwiseAbs().maxCoeff() > 1 - 1e-9))
     throw UsageError("phantom --fov-face: expected a unit axis direction");
@@ -412,6 +500,13 @@ PhantomOptions::Metal metalFromName(const std::string& name) {
   if (name == "screw") return PhantomOptions::Metal::Screw;
   if (name == "stem") return PhantomOptions::Metal::Stem;
   throw UsageError("--metal '" + name + "': expected screw or stem");
+}
+
+PhantomOptions::Kernel kernelFromName(const std::string& name) {
+  if (name == "standard") return PhantomOptions::Kernel::Standard;
+  if (name == "soft") return PhantomOptions::Kernel::Soft;
+  if (name == "sharp") return PhantomOptions::Kernel::Sharp;
+  throw UsageError("--kernel '" + name + "': expected standard, soft or sharp");
 }
 
 Vector3d faceDirection(const std::string& face) {
@@ -455,6 +550,15 @@ Phantom makePhantom(const PhantomOptions& o) {
   } else if (o.metal == PhantomOptions::Metal::Stem) {
     a.metal.push_back({requested.shaft_top + Vector3d(0, 0, 5.0), requested.shaft_top - Vector3d(0, 0, 140.0), 6.0});
   }
+  if (o.contrast_vessel) {
+    // Anterior (LPS -y) and a little medial of the head, its wall 5 mm off
+    // the bounding sphere, running down and a little laterally.
+    const double s = requested.truth.right ? -1.0 : 1.0, radius = 3.0;
+    const Vector3d offset = Vector3d(-s * 0.35, -1.0, 0.0).normalized() * (requested.rmax + 5.0 + radius);
+    const Vector3d along = Vector3d(-s * 0.15, 0.0, 1.0).normalized();
+    const Vector3d at = requested.center + offset;
+    a.vessel = Cylinder{at - 400.0 * along, at + 400.0 * along, radius};
+  }
   if (o.cancellous_variation_hu > 0) a.wave_phase = Vector3d(uniform(0, 2 * M_PI), uniform(0, 2 * M_PI), uniform(0, 2 * M_PI));
 
   // The grid: head, socket and pelvis medially, neck and shaft laterally.
@@ -484,6 +588,12 @@ Phantom makePhantom(const PhantomOptions& o) {
     }
     hi[1] = std::max(hi[1], mid[1] + 82.0);
   }
+  if (o.table) {
+    // The table's trough 5 mm beyond the field's back, under the body's
+    // middle (x = 0), rising towards the sides; the grid holds it and 15 mm of air.
+    a.table_axis = Eigen::Vector2d(0.0, hi[1] + 5.0 - a.table_radius);
+    hi[1] += 5.0 + a.table_thickness + 15.0;
+  }
   imaging::ImageGeometry g;
   g.spacing = o.spacing;
   for (int ax = 0; ax < 3; ++ax) g.size[ax] = static_cast<int>(std::ceil((hi[ax] - lo[ax]) / o.spacing[ax])) + 1;
@@ -501,38 +611,21 @@ Phantom makePhantom(const PhantomOptions& o) {
   for (const HipAnatomy& h : a.hips) out.hips.push_back(h.truth);
   out.head = out.hips[0].head;
   out.neck_axis = out.hips[0].neck_axis;
-  out.ct.geometry = g;
-  out.ct.voxels.resize(static_cast<size_t>(g.voxelCount()));
-  out.femur.geometry = g;
-  out.femur.voxels.assign(out.ct.voxels.size(), 0);
-  const double half_diagonal = 0.5 * o.spacing.norm();
-  const int sub = 3;  // partial volume: 3 x 3 x 3 samples in voxels near an interface
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i) {
-        const Vector3d x = g.toPhysical(Vector3d(i, j, k));
-        double interface = 0;
-        int label = 0;
-        double value = a.hu(x, interface, &label);
-        if (interface < half_diagonal) {
-          value = 0;
-          double ignored = 0;
-          for (int c = 0; c < sub * sub * sub; ++c) {
-            const Vector3d offset((c % sub + 0.5) / sub - 0.5, (c / sub % sub + 0.5) / sub - 0.5, (c / (sub * sub) + 0.5) / sub - 0.5);
-            value += a.hu(g.toPhysical(Vector3d(i, j, k) + offset), ignored);
-          }
-          value /= sub * sub * sub;
-        }
-        out.ct.at(i, j, k) = static_cast<float>(value);
-        out.femur.at(i, j, k) = static_cast<std::uint8_t>(label);
-      }
+  if (o.slice_thickness_mm > g.spacing[2]) {
+    renderThickSlices(a, g, o.slice_thickness_mm, out.ct, out.femur);
+  } else {
+    render(a, g, out.ct, out.femur);
+  }
   detail::blur(out.ct, Vector3d::Constant(o.blur_mm));
   if (!a.metal.empty())
     detail::addMetalStreaks(out.ct, [&a](const Vector3d& x) { return a.metalDepth(x) > 0; }, o.seed ^ 0x3e7a1c5ULL);
   std::normal_distribution<double> noise(0.0, o.noise_hu);
   if (o.noise_hu > 0)
     for (float& v : out.ct.voxels) v += static_cast<float>(noise(rng));
-  if (!a.metal.empty()) detail::clipToScannerRange(out.ct);
+  // The kernel filters the tissues and their noise together, within the slices.
+  if (o.kernel == PhantomOptions::Kernel::Soft) detail::blur(out.ct, Vector3d(0.6, 0.6, 0.0));
+  if (o.kernel == PhantomOptions::Kernel::Sharp) detail::sharpenInPlane(out.ct, 0.8, 1.0);
+  if (!a.metal.empty() || a.table_axis) detail::clipToScannerRange(out.ct);
   if (crop) applyFovCrop(*crop, out);
 
   // Top level: the requested side's head, as in the single-hip phantom; `hips`: every head.
@@ -573,6 +666,19 @@ Phantom makePhantom(const PhantomOptions& o) {
                           {"hu", o.metal_hu},
                           {"clipped_to_hu", {-1024, 3071}}};
   }
+  if (o.kernel != PhantomOptions::Kernel::Standard) out.truth["kernel"] = o.kernel == PhantomOptions::Kernel::Soft ? "soft" : "sharp";
+  if (o.slice_thickness_mm > g.spacing[2]) out.truth["slice_thickness_mm"] = o.slice_thickness_mm;
+  if (a.vessel)
+    out.truth["contrast_vessel"] = {{"point_mm", vec(0.5 * (a.vessel->a + a.vessel->b))},
+                                    {"direction", vec((a.vessel->b - a.vessel->a).normalized())},
+                                    {"radius_mm", a.vessel->radius},
+                                    {"hu", o.vessel_hu}};
+  if (a.table_axis)
+    out.truth["table"] = {{"axis_xy_mm", {(*a.table_axis)[0], (*a.table_axis)[1]}},
+                          {"radius_mm", a.table_radius},
+                          {"thickness_mm", a.table_thickness},
+                          {"hu", a.table_hu},
+                          {"air_hu", a.air_hu}};
   if (crop) {
     const double beyond = crop->head_extent - crop->plane;
     out.truth["fov_cut"] = {{"face", vec(crop->u)},

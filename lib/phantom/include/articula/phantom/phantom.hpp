@@ -109,6 +109,26 @@ struct PhantomOptions {
   Metal metal = Metal::None;
   double metal_hu = 8000.0;
 
+  /// The reconstruction kernel, applied within the slices to the blurred
+  /// tissues and their noise: soft smooths (a further Gaussian of 0.6 mm),
+  /// sharp enhances edges (unsharp masking, sigma 0.8 mm, gain 1: an
+  /// overshoot at each edge and noise about twice as strong, correlated).
+  enum class Kernel { Standard, Soft, Sharp };
+  Kernel kernel = Kernel::Standard;
+  /// A contrast-filled vessel, 6 mm across at vessel_hu, running superior to
+  /// inferior anterior-medial to the requested head, its wall 5 mm from the
+  /// head's bounding sphere, like the femoral artery of a CT angiogram.
+  bool contrast_vessel = false;
+  double vessel_hu = 300.0;
+  /// The patient table: a curved slab (radius 400 mm, 6 mm thick, 700 HU)
+  /// under the patient's back, posterior, with air beyond it; the grid grows
+  /// 26 mm posteriorly to hold it.
+  bool table = false;
+  /// Slices thicker than their spacing: each slice averages the tissues over
+  /// a box this wide (mm) across the slices, before the blur; 0 or up to
+  /// spacing[2]: the slice's own width.
+  double slice_thickness_mm = 0.0;
+
   /// Osteoporotic bone: cortex 0.8 mm at 700 HU, cancellous 190 +- 90 HU.
   void makeOsteoporotic();
   /// Throws UsageError naming the first invalid option.
@@ -181,6 +201,9 @@ struct Phantom {
 
 /// Metal::None, Screw or Stem from "none", "screw", "stem"; throws UsageError otherwise.
 PhantomOptions::Metal metalFromName(const std::string& name);
+
+/// Kernel::Standard, Soft or Sharp from "standard", "soft", "sharp"; throws UsageError otherwise.
+PhantomOptions::Kernel kernelFromName(const std::string& name);
 
 /// The unit LPS direction of a face of the field of view: +x, -x, +y, -y,
 /// +z, -z, or the patient's L, R, P, A, S, I; throws UsageError otherwise.
