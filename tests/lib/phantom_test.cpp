@@ -668,8 +668,8 @@ TEST(Phantom, KernelsSmoothOrSharpenEdgesAndNoise) {
       }
     }
     if (kernel == phantom::PhantomOptions::Kernel::Sharp) {
-      EXPECT_GT(highest, o.cortical_hu + 100);
-      EXPECT_LT(lowest, o.soft_tissue_hu - 100);
+      EXPECT_GT(highest, o.cortical_hu + 50);
+      EXPECT_LT(lowest, o.soft_tissue_hu - 50);
     } else {
       EXPECT_LE(highest, o.cortical_hu + 1);
       EXPECT_GE(lowest, o.soft_tissue_hu - 1);
