@@ -26,8 +26,10 @@ constexpr double kInsideWarn = 0.15, kInsideFail = 0.30;      // share of the po
 // The cortex's contrast across the slices relative to within them: 0.38-1.05
 // on the correct heads of two phantom generators (1.5 x 1.5 x 3 mm voxels
 // included); 0.06-0.26 where a thin cortex under 1.5-2.5 mm of blur across
-// 2-3 mm slices put the surface 0.36-0.79 mm outside on average.
-constexpr double kSliceContrastWarn = 0.3;
+// 2-3 mm slices put the surface 0.36-0.79 mm outside on average; 0.30 where
+// 4 mm thick slices (every 2 mm) put it 0.31 mm outside, beyond half the
+// 0.7 mm voxel (the clinical matrix), and 0.35 at 1 mm voxels, 0.30 mm out.
+constexpr double kSliceContrastWarn = 0.35;
 constexpr double kSliceAxisShare = 0.8, kInPlaneShare = 0.3;  // |normal . slice axis| of the two groups of lines
 constexpr int kMinLinesPerGroup = 20;
 constexpr double kMinInPlaneContrastHu = 100;
@@ -57,7 +59,16 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // Metal near the head: voxels above 2,500 HU (cortical bone reaches about
 // 2,000) within two radii of its centre, warned from 100 mm^3 (a screw of
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
-constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;                              // warnings of the structure's checks
+constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
+// The fitted sphere beyond the field of view on its farthest side, relative
+// to the radius. On the clinical matrix (bench/clinical.sh: 6 heads, each
+// face cut 0, 10, 25 and 50 % of the radius into the head): 0-0.09 at a
+// tangent, 0.06-0.19 at 10 %, 0.20-0.34 at 25 %, 0.41-0.59 at 50 % (a head's
+// extent along a face and its fitted sphere's differ by up to 6 %); 0 on
+// every uncut CT. Warned above 0.03: every cut of a tenth of the radius, on
+// the neck's side too, where the share above (its cone about the neck left
+// out) stayed at 0.00-0.08.
+constexpr double kBeyondFovWarn = 0.03;                              // warnings of the structure's checks
 
 // A yes-or-no check of how the head was found: 1 passes, 0 warns; no doubt
 // about the structure either way.
@@ -248,6 +259,18 @@ double metalNearHead(const imaging::Volume& ct, const Eigen::Vector3d& center, d
   return static_cast<double>(metal) * g.spacing.prod();
 }
 
+double headBeyondFieldOfView(const imaging::ImageGeometry& grid, const Eigen::Vector3d& center, double radius_mm) {
+  // The grid's axes are orthonormal: the sphere spans radius / spacing
+  // indices either way along each, about its centre's index.
+  const Eigen::Vector3d c = grid.toIndex(center);
+  double beyond = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double reach = radius_mm / grid.spacing[a];
+    beyond = std::max({beyond, (c[a] + reach - (grid.size[a] - 1)) * grid.spacing[a], (reach - c[a]) * grid.spacing[a]});
+  }
+  return beyond;
+}
+
 QcReport checkHead(const HeadQcInput& in) {
   const Eigen::Index n = in.points.rows();
   if (n < 4) throw InputError("head checks need at least 4 points, found " + std::to_string(n));
@@ -393,6 +416,18 @@ QcReport checkHead(const HeadQcInput& in) {
              "warn when neither the body's middle, a field of view holding both sides, nor the socket tells the side",
              "the joint's side could not be verified (a narrow field of view without the body's outline, and no "
              "socket clearly medial to the head): the joint in view was taken as the requested side"));
+  if (in.head_beyond_fov_mm) {
+    // Of what the data covers, not of the structure (as the share above).
+    QcCheck beyond = grade("head_beyond_fov_relative", *in.head_beyond_fov_mm / r, kBeyondFovWarn, std::nullopt, false,
+                           "the field of view ends inside the head's sphere: it reaches beyond the CT's last voxels, "
+                           "relative to its radius, by");
+    beyond.of_structure = false;
+    if (beyond.status == "warn")
+      beyond.reason += " (" + number(*in.head_beyond_fov_mm) +
+                       " mm; on the neck's side too): the points cover only the part in view, and the fitted shape "
+                       "extrapolates the rest";
+    report.checks.push_back(beyond);
+  }
   // Doubts compound: two checks of the structure that each find the head
   // doubtful are two independent signs of a wrong structure (on the phantom matrix, the one
   // head with two warnings had taken part of its socket; no correct head

@@ -113,6 +113,7 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
   if (ct) {
     in.head_outside_volume_share = headOutsideVolumeShare(ct->geometry, in.points, in.sphere_center, in.sphere_radius_mm);
     in.metal_near_head_mm3 = metalNearHead(*ct, in.sphere_center, in.sphere_radius_mm);
+    in.head_beyond_fov_mm = headBeyondFieldOfView(ct->geometry, in.sphere_center, in.sphere_radius_mm);
   }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
