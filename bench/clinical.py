@@ -121,28 +121,34 @@ def summary(rows):
     return "\n".join(lines)
 
 
-def fov_table(rows):
-    """The field-of-view cuts: per face and depth, how many heads
-    head_outside_volume_share flagged, and its values."""
+def fov_table(rows, check):
+    """The field-of-view cuts: per face and depth, how many heads `check`
+    flagged (warned or failed) and the range of its values."""
     fov = [r for r in rows if r["mode"] == "FOV cut"]
     if not fov:
         return ""
     depths = sorted({r["strength"].split(" ", 1)[1] for r in fov}, key=lambda s: int(s.split()[0]))
     lines = ["| face | " + " | ".join(depths) + " |", "|---|" + "---|" * len(depths)]
-    for face in FACES:
+    # The faces, then the left-right faces by side: lateral is the neck's side.
+    lateral = lambda r: FACE_NAMES["-x" if r["side"] == "right" else "+x"]
+    groups = [(f"{face} ({FACE_NAMES[face]})", lambda r, face=face: r["strength"].startswith(FACE_NAMES[face] + " "))
+              for face in FACES]
+    groups += [("lateral (the neck's side)", lambda r: r["strength"].startswith(lateral(r) + " ")),
+               ("medial", lambda r: r["strength"][0] in "LR" and not r["strength"].startswith(lateral(r) + " "))]
+    for title, on_face in groups:
         cells = []
         for depth in depths:
-            g = [r for r in fov if r["strength"] == f"{FACE_NAMES[face]} {depth}"]
+            g = [r for r in fov if on_face(r) and r["strength"].endswith(" " + depth)]
             if not g:
                 cells.append("")
                 continue
-            values = [r.get("checks", {}).get("head_outside_volume_share") for r in g]
+            values = [r.get("checks", {}).get(check) for r in g]
             flagged = sum(v is not None and v[0] != "pass" for v in values)
-            shown = [f"{v[1]:.3f}" for v in values if v is not None]
+            shown = [v[1] for v in values if v is not None]
             refused = sum(r["exit"] != 0 for r in g)
-            cells.append(f"{flagged}/{len(g)}" + (f" ({min(shown)}-{max(shown)})" if shown else "") +
+            cells.append(f"{flagged}/{len(g)}" + (f" ({min(shown):.3f}-{max(shown):.3f})" if shown else "") +
                          (f", {refused} refused" if refused else ""))
-        lines.append(f"| {face} ({FACE_NAMES[face]}) | " + " | ".join(cells) + " |")
+        lines.append(f"| {title} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -169,9 +175,13 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--ids", default="", help="comma-separated case ids (e.g. h0-03) or head ids (h2) to run")
     ap.add_argument("--modes", default="", help="comma-separated modes to run, e.g. 'FOV cut,metal'")
+    ap.add_argument("--tables-only", action="store_true", help="write the tables again from WORK/clinical.json")
     args = ap.parse_args()
     bin_dir = os.path.abspath(args.bin)
     os.makedirs(args.work, exist_ok=True)
+    if args.tables_only:
+        write_tables(json.load(open(os.path.join(args.work, "clinical.json"))), args.work)
+        return
     todo = cases(args.quick)
     if args.ids:
         ids = args.ids.split(",")
@@ -188,11 +198,18 @@ def main():
                   f"{'; '.join(r['flags'])}", file=sys.stderr)
     rows.sort(key=lambda r: r["id"])
     json.dump(rows, open(os.path.join(args.work, "clinical.json"), "w"), indent=1)
-    text = (summary(rows) + "\n\nField-of-view cuts, heads flagged by head_outside_volume_share (its values):\n\n" +
-            fov_table(rows) + "\n\nCases not right:\n\n" + cases_table(rows, only_notable=True))
-    open(os.path.join(args.work, "clinical.md"), "w").write(text + "\n\nEvery case:\n\n" + cases_table(rows) + "\n")
-    print(text)
+    write_tables(rows, args.work)
     print(f"\n{len(rows)} cases in {time.time() - t0:.0f} s wall with -j {args.j}", file=sys.stderr)
+
+
+def write_tables(rows, work):
+    """Prints the tables and writes them, with every case, to WORK/clinical.md."""
+    text = summary(rows)
+    for check in ("head_beyond_fov_relative", "head_outside_volume_share"):
+        text += f"\n\nField-of-view cuts, heads flagged by {check} (its values):\n\n" + fov_table(rows, check)
+    text += "\n\nCases not right:\n\n" + cases_table(rows, only_notable=True)
+    open(os.path.join(work, "clinical.md"), "w").write(text + "\n\nEvery case:\n\n" + cases_table(rows) + "\n")
+    print(text)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Clinical failure modes: `articula run` on 6 phantom heads (the five
 # models; radii 18-28 mm; right and left; 0.6 x 0.6 x 1 to 1 x 1 x 3 mm
-# voxels; one in a both-hips pelvis CT) x 39 cases of what clinical CT adds:
+# voxels; one in a both-hips pelvis CT) x 41 cases of what clinical CT adds:
 # none; a flattened dome (0.1, 0.25 of the radius); osteophytes (1.5, 3 mm);
 # cysts; a narrowed joint (0.8, 0.5 mm); the field of view cut at 0, 10, 25
 # and 50 % of the radius from each of the six faces; a screw in the neck, a
@@ -15,6 +15,7 @@
 # and depth; the cases not right); writes WORK/clinical.md (with every case)
 # and WORK/clinical.json.
 #   bash bench/clinical.sh [-j N] [--quick] [--ids h0,h2-05] [--modes 'FOV cut,metal'] [build/bin] [WORK]
+# (python3 bench/clinical.py --work WORK --tables-only writes the tables again.)
 # Needs build/bin/articula and build/bin/bench-score-head (the scorer).
 set -euo pipefail
 jobs=1 extra=()
