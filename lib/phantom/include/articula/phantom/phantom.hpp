@@ -17,7 +17,10 @@
 // keeps its CT): the changes of an arthritic hip on the requested side's head
 // (a flattened dome, osteophytes at the head-neck junction, subchondral cysts,
 // a joint space narrowed over a superior patch), recorded in truth.json as
-// departures of the true articular surface from the head's model.
+// departures of the true articular surface from the head's model; and the
+// scan's (a field of view that clips the head, a screw or a stem with metal
+// streaks, soft or sharp kernels, a contrast-filled vessel, the patient
+// table, slices thicker than their spacing).
 #include <optional>
 #include <string>
 #include <vector>
