@@ -57,7 +57,12 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // Metal near the head: voxels above 2,500 HU (cortical bone reaches about
 // 2,000) within two radii of its centre, warned from 100 mm^3 (a screw of
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
-constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;                              // warnings of the structure's checks
+constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
+// The bone departs from the selected model over its cap (cap_departures.hpp):
+// the largest region beyond the threshold, a hip's fovea aside. Warned from
+// 40 mm^2: a dome flattened by a tenth of a 20 mm radius departs over about
+// 125 mm^2, a 3 mm osteophyte over about 50 mm^2.
+constexpr double kDepartureWarnMm2 = 40;
 
 // A yes-or-no check of how the head was found: 1 passes, 0 warns; no doubt
 // about the structure either way.
@@ -354,6 +359,17 @@ QcReport checkHead(const HeadQcInput& in) {
     if (metal.status == "warn")
       metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
     report.checks.push_back(metal);
+  }
+  if (in.cap_departure_mm2) {
+    // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
+    QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
+                            "the bone departs from the selected model over part of its cap: the largest departing "
+                            "region (mm^2, a hip's fovea aside) is");
+    departs.of_structure = false;
+    if (departs.status == "warn")
+      departs.reason += ": a flattened or eroded dome, an osteophyte, or a head no model of the hierarchy follows "
+                        "there; the model describes the rest (see cap_departures in results.json)";
+    report.checks.push_back(departs);
   }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
     // Femoral heads lie 60-110 mm from the body's middle (half the distance

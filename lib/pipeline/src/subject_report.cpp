@@ -20,6 +20,7 @@
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/shape.hpp"
 #include "articula/core/csv.hpp"
+#include "articula/pipeline/cap_departures.hpp"
 #include "articula/pipeline/markups.hpp"
 #include "articula/imaging/edges.hpp"
 #include "articula/imaging/io.hpp"
@@ -28,6 +29,7 @@
 #include "articula/pipeline/slicer_scene.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
+#include "articula/points/mesh_file.hpp"
 #include "articula/points/point_io.hpp"
 #include "articula/report/markup_text.hpp"
 
@@ -88,8 +90,10 @@ json readStageJson(const fs::path& path) {
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
 QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
-                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct) {
+                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct,
+                          const std::optional<CapDepartures>& departures) {
   HeadQcInput in;
+  if (departures) in.cap_departure_mm2 = departures->largestFindingMm2();
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
@@ -170,6 +174,24 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volu
   } catch (const Error& e) {
     return "<p class=\"note\">No CT slices: " + report::escapeMarkup(e.what()) + "</p>";
   }
+}
+
+// Where the bone's mesh departs from the selected model over the cap
+// (pipeline/cap_departures.hpp); none without the mesh.
+std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const geometry::ShapeParameters& model,
+                                                 const imaging::Volume* ct, const std::string& joint,
+                                                 const std::string& side) {
+  if (!fs::exists(folder / "bone.vtp")) return std::nullopt;
+  const points::MeshFile mesh = points::readMeshFile(folder / "bone.vtp");
+  CapDepartureInput in;
+  in.vertices = mesh.vertices;
+  in.triangles = mesh.triangles;
+  in.model = model;
+  in.points = points::readPoints(folder / "points.ply").positions;
+  if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
+  // LPS: +x is the patient's left, so a right hip's medial side is +x.
+  if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
+  return capDepartures(in);
 }
 
 }  // namespace
@@ -272,7 +294,11 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
 
   std::string no_ct;
   const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
-  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get());
+  geometry::ShapeParameters selected_shape = best_shape;
+  for (const auto& shape : shapes)
+    if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
+  const std::optional<CapDepartures> departures = departuresFromModel(o.folder, selected_shape, ct.get(), o.joint, o.side);
+  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get(), departures);
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
@@ -300,6 +326,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
         {"undetermined", selection.undetermined}}},
       {"head_center_mm", {c[0], c[1], c[2]}},
       {"qc", qc.toJson()},
+      {"cap_departures", departures ? departures->toJson() : json(nullptr)},
       {"models", models},
       {"coordinate_system", "LPS"},
       {"units", "mm"},
