@@ -83,6 +83,13 @@ TEST(CapDepartures, AFlattenedDomeIsMeasuredInAreaAndDepth) {
   EXPECT_GT(dome.direction.z(), 0.99);
   EXPECT_EQ(dome.where, "superior");
   EXPECT_NEAR(d.largestFindingMm2(), dome.area_mm2, 1e-9);
+  // Every vertex of the region, and only those, is marked with it: on the plane, deeper than t.
+  ASSERT_EQ(d.region_of_vertex.size(), static_cast<size_t>(c.input.vertices.rows()));
+  for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v) {
+    const bool deep = std::abs(c.local(v).z() - plane) < 1e-9 && c.local(v).norm() < kRadius - t - 1e-6;
+    const bool edge = std::abs(c.local(v).norm() - (kRadius - t)) < 0.05;  // rounding at the border
+    if (!edge) EXPECT_EQ(d.region_of_vertex[static_cast<size_t>(v)], deep ? 0 : -1) << v;
+  }
 }
 
 TEST(CapDepartures, AnOsteophyteOnTheRimIsOutwardAndAPitAtTheMedialPoleIsTheFovea) {

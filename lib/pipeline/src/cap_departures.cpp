@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include <Eigen/Geometry>
 
@@ -202,6 +203,7 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
     if (distance_mm > out.threshold_mm) outward[static_cast<size_t>(v)] = 1;
   }
 
+  std::vector<int> region_of_vertex(static_cast<size_t>(V.rows()), -1);
   for (const bool is_inward : {true, false}) {
     const std::vector<int> part = geometry::connectedParts(is_inward ? inward : outward, in.triangles);
     std::vector<DepartingRegion> regions;
@@ -219,6 +221,7 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       region.centre += a * V.row(static_cast<Eigen::Index>(v)).transpose();
       region.depth_mm = std::max(region.depth_mm, std::abs(vertex_distance[v]));
     }
+    std::vector<int> kept_as(regions.size(), -1);
     for (size_t k = 0; k < regions.size(); ++k) {
       DepartingRegion& region = regions[k];
       // Outwards, a region that runs on beyond the rim is the neck rising
@@ -234,10 +237,26 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       if (is_inward && in.medial && degrees(region.direction, *in.medial) <= kFoveaMaxAngleDeg &&
           region.area_mm2 <= kFoveaMaxAreaMm2 && region.depth_mm <= kFoveaMaxDepthMm)
         region.kind = "fovea";
+      kept_as[k] = static_cast<int>(out.regions.size());
       out.regions.push_back(region);
     }
+    for (size_t v = 0; v < part.size(); ++v)
+      if (part[v] >= 0 && kept_as[static_cast<size_t>(part[v])] >= 0) region_of_vertex[v] = kept_as[static_cast<size_t>(part[v])];
   }
-  std::sort(out.regions.begin(), out.regions.end(), [](const auto& a, const auto& b) { return a.area_mm2 > b.area_mm2; });
+  // Largest first, the vertices' region indices following.
+  std::vector<int> order(out.regions.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&out](int a, int b) { return out.regions[static_cast<size_t>(a)].area_mm2 > out.regions[static_cast<size_t>(b)].area_mm2; });
+  std::vector<int> rank(order.size());
+  std::vector<DepartingRegion> sorted;
+  for (size_t k = 0; k < order.size(); ++k) {
+    rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+    sorted.push_back(out.regions[static_cast<size_t>(order[k])]);
+  }
+  out.regions = std::move(sorted);
+  for (int& r : region_of_vertex)
+    if (r >= 0) r = rank[static_cast<size_t>(r)];
+  out.region_of_vertex = std::move(region_of_vertex);
   return out;
 }
 

@@ -367,8 +367,9 @@ QcReport checkHead(const HeadQcInput& in) {
                             "region (mm^2, a hip's fovea aside) is");
     departs.of_structure = false;
     if (departs.status == "warn")
-      departs.reason += ": a flattened or eroded dome, an osteophyte, or a head no model of the hierarchy follows "
-                        "there; the model describes the rest (see cap_departures in results.json)";
+      departs.reason += ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone "
+                        "taken in, a slice too many at coarse slices), or a head no model of the hierarchy follows there; "
+                        "the model describes the rest (see cap_departures in results.json and the slices)";
     report.checks.push_back(departs);
   }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {

@@ -111,6 +111,35 @@ std::string checksSection(const json& results) {
   return html + "</table></section>\n";
 }
 
+// What the articular selection left out: where the bone departs from the
+// selected model over its cap (results.json's cap_departures).
+std::string departuresSection(const json& results) {
+  const json& d = member(results, "cap_departures");
+  if (!d.is_object()) return "";
+  std::string html = "<section id=\"departures\"><h2>Where the bone departs from the model</h2>\n<p class=\"note\">The bone's "
+                     "surface over the articular cap and its rim, measured against the selected model: regions beyond " +
+                     fixed(numberAt(d, "threshold_mm"), 2) + " mm (the largest of 0.75 mm, three times the points' scatter and 0.3 voxel) and of " +
+                     fixed(numberAt(d, "min_region_mm2"), 0) + " mm&sup2; or more. The points leave them out, so the model "
+                     "describes the rest of the cap. Landmarks departure_1, ... in head.mrk.json; red in the 3-D view.</p>\n";
+  const json& regions = member(d, "regions");
+  if (!regions.is_array() || regions.empty()) return html + "<p>None: the bone follows the model over the cap.</p></section>\n";
+  html += "<table><tr><th>region</th><th>kind</th><th>area (mm&sup2;)</th><th>depth (mm)</th><th>where</th>"
+          "<th>centre (LPS mm)</th></tr>\n";
+  int k = 0;
+  for (const auto& r : regions) {
+    const json& centre = member(r, "centre_mm");
+    std::string at;
+    for (int i = 0; i < 3 && centre.is_array() && centre.size() == 3; ++i)
+      at += (i ? ", " : "") + fixed(centre[static_cast<size_t>(i)].is_number() ? centre[static_cast<size_t>(i)].get<double>() : NAN, 1);
+    const std::string kind = text(r, "kind");
+    html += "<tr><td>departure_" + std::to_string(++k) + "</td><td>" +
+            report::escapeMarkup(kind == "fovea" ? "fovea (a pit at the medial pole: anatomy)" : kind) + "</td><td>" +
+            fixed(numberAt(r, "area_mm2"), 0) + "</td><td>" + fixed(numberAt(r, "depth_mm"), 1) + "</td><td>" +
+            report::escapeMarkup(text(r, "where")) + "</td><td>" + at + "</td></tr>\n";
+  }
+  return html + "</table></section>\n";
+}
+
 std::string modelsSection(const json& results) {
   const std::string selected = results.value("selected_model", ""), best = results.value("best_model", "");
   std::string html = "<section id=\"models\"><h2>Models</h2>\n<table><tr><th>model</th><th>parameters</th>"
@@ -228,6 +257,7 @@ std::string subjectReportHtml(const json& results, const fs::path& folder, const
           "magenta, the segmentation's edge in yellow; radiological view (the patient's left on the right).</p>\n" +
           slices_html + "</section>\n";
   html += checksSection(results);
+  html += departuresSection(results);
   html += modelsSection(results);
   html += "<section id=\"errors\"><h2>Signed distances of the points to each model</h2>\n" +
           inlineSvg(folder / "errors" / "histogram.svg") + "\n" + inlineSvg(folder / "errors" / "error_map.svg") +

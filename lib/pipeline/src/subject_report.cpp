@@ -178,11 +178,11 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volu
 
 // Where the bone's mesh departs from the selected model over the cap
 // (pipeline/cap_departures.hpp); none without the mesh.
-std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const geometry::ShapeParameters& model,
-                                                 const imaging::Volume* ct, const std::string& joint,
-                                                 const std::string& side) {
-  if (!fs::exists(folder / "bone.vtp")) return std::nullopt;
-  const points::MeshFile mesh = points::readMeshFile(folder / "bone.vtp");
+std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const std::optional<points::MeshFile>& bone,
+                                                 const geometry::ShapeParameters& model, const imaging::Volume* ct,
+                                                 const std::string& joint, const std::string& side) {
+  if (!bone) return std::nullopt;
+  const points::MeshFile& mesh = *bone;
   CapDepartureInput in;
   in.vertices = mesh.vertices;
   in.triangles = mesh.triangles;
@@ -192,6 +192,34 @@ std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const g
   // LPS: +x is the patient's left, so a right hip's medial side is +x.
   if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
   return capDepartures(in);
+}
+
+// The bone's triangles whose corners all lie in one departing region (a
+// fovea aside), for the 3-D view.
+report::ViewSurface departingSurface(const points::MeshFile& bone, const CapDepartures& departures) {
+  std::vector<int> new_index(static_cast<size_t>(bone.vertices.rows()), -1);
+  std::vector<Eigen::Vector3i> kept;
+  int n_vertices = 0;
+  const auto region = [&departures](int v) { return departures.region_of_vertex[static_cast<size_t>(v)]; };
+  for (Eigen::Index f = 0; f < bone.triangles.rows(); ++f) {
+    const int r = region(bone.triangles(f, 0));
+    if (r < 0 || region(bone.triangles(f, 1)) != r || region(bone.triangles(f, 2)) != r ||
+        departures.regions[static_cast<size_t>(r)].kind == "fovea")
+      continue;
+    Eigen::Vector3i t;
+    for (int k = 0; k < 3; ++k) {
+      int& index = new_index[static_cast<size_t>(bone.triangles(f, k))];
+      if (index < 0) index = n_vertices++;
+      t[k] = index;
+    }
+    kept.push_back(t);
+  }
+  report::ViewSurface surface{"departing from the model", Eigen::MatrixX3d(n_vertices, 3),
+                              Eigen::MatrixX3i(static_cast<Eigen::Index>(kept.size()), 3)};
+  for (size_t v = 0; v < new_index.size(); ++v)
+    if (new_index[v] >= 0) surface.vertices.row(new_index[v]) = bone.vertices.row(static_cast<Eigen::Index>(v));
+  for (size_t f = 0; f < kept.size(); ++f) surface.triangles.row(static_cast<Eigen::Index>(f)) = kept[f].transpose();
+  return surface;
 }
 
 }  // namespace
@@ -288,17 +316,29 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
   for (int i = 0; i < 3; ++i)
     axes.push_back({axis_names[i], c - semiAxes(best_shape)[i] * R.col(i), c + semiAxes(best_shape)[i] * R.col(i)});
-  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
-  SlicerSceneContent scene;
-  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
 
   std::string no_ct;
   const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
   geometry::ShapeParameters selected_shape = best_shape;
   for (const auto& shape : shapes)
     if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
-  const std::optional<CapDepartures> departures = departuresFromModel(o.folder, selected_shape, ct.get(), o.joint, o.side);
+  std::optional<points::MeshFile> bone;
+  if (fs::exists(o.folder / "bone.vtp")) bone = points::readMeshFile(o.folder / "bone.vtp");
+  const std::optional<CapDepartures> departures =
+      departuresFromModel(o.folder, bone, selected_shape, ct.get(), o.joint, o.side);
   const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get(), departures);
+  // The head centre, and where the bone departs from the selected model.
+  std::vector<Landmark> landmarks = {{"head_center", c}};
+  if (departures)
+    for (size_t k = 0; k < departures->regions.size(); ++k) {
+      const DepartingRegion& region = departures->regions[k];
+      landmarks.push_back({"departure_" + std::to_string(k + 1) + " (" + region.kind + ", " + number(std::round(region.area_mm2)) +
+                               " mm2, " + number(std::round(10 * region.depth_mm) / 10) + " mm)",
+                           region.centre});
+    }
+  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", landmarks, axes);
+  SlicerSceneContent scene;
+  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", landmarks, axes);
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
@@ -341,7 +381,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     if (fs::exists(o.folder / "errors" / ("points_" + geometry::modelName(shape.model) + ".vtp")))
       scene.models.push_back(geometry::modelName(shape.model));
   try {
-    const report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
+    report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
+    if (bone && departures) view.departures = departingSurface(*bone, *departures);
     for (const auto& d : view.distances) scene.colour_range_mm[d.model] = report::symmetricColourRange(d.signed_distance_mm);
     view_html = report::web3dViewHtml(view);
   } catch (const Error& e) {

@@ -121,6 +121,7 @@ constexpr const char* kViewScript = R"JS(
     toggles.appendChild(l);
   }
   if (data.bone) toggle('bone', mesh(data.bone, 0xe3d6b8, 0.35), true);
+  if (data.departures) toggle('departing from the model', mesh(data.departures, 0xd62728, 0.9), true);
   var palette = [0x4daf4a, 0xff7f00, 0x984ea3, 0xa65628, 0xe7298a, 0x999999];
   data.surfaces.forEach(function (s, i) {
     toggle(s.name + ' (fitted)', mesh(s, palette[i % palette.length], 0.3), false);
@@ -184,6 +185,8 @@ double symmetricColourRange(const Eigen::VectorXd& signed_distance_mm) {
 std::string web3dViewHtml(const View3d& view) {
   json data = {{"radius_mm", view.radius_mm}, {"selected", view.selected_model}, {"surfaces", json::array()}};
   if (view.bone.vertices.rows() > 0 && view.bone.triangles.rows() > 0) data["bone"] = surfaceJson(view.bone, view.centre);
+  if (view.departures.vertices.rows() > 0 && view.departures.triangles.rows() > 0)
+    data["departures"] = surfaceJson(view.departures, view.centre);
   for (const auto& s : view.fitted)
     if (s.vertices.rows() > 0 && s.triangles.rows() > 0) data["surfaces"].push_back(surfaceJson(s, view.centre));
   if (view.points.rows() > 0) {
@@ -199,7 +202,7 @@ std::string web3dViewHtml(const View3d& view) {
   std::string html =
       "<section id=\"view3d\"><h2>3-D view</h2>\n"
       "<p class=\"note\">Drag to turn, scroll to zoom, right-drag to pan. Seen from the front, head up. Tick a fitted "
-      "surface to show it. The points are coloured by their signed distance to the chosen model (98 % of them within the bar's range; the rest "
+      "surface to show it. Red: where the bone departs from the selected model (see the departures' table). The points are coloured by their signed distance to the chosen model (98 % of them within the bar's range; the rest "
       "saturate).</p>\n"
       "<div class=\"view3d-controls\"><span id=\"view3d-toggles\"></span> <label>colour points by <select "
       "id=\"view3d-colouring\"></select></label></div>\n"

@@ -34,7 +34,8 @@ struct CapDepartures {
   double rim_extension_deg = 0;                        // outward departures are sought this far beyond the cap
   double threshold_mm = 0;                             // a vertex departs beyond this distance
   double cap_area_mm2 = 0;                             // mesh area measured within the cap
-  std::vector<DepartingRegion> regions;                // area at least kMinRegionMm2, largest first
+  std::vector<DepartingRegion> regions;                // area at least kMinDepartingRegionMm2, largest first
+  std::vector<int> region_of_vertex;                   // per mesh vertex: its index in `regions`, or -1
   /// The largest area among regions that are not a fovea (0 if none).
   double largestFindingMm2() const;
   nlohmann::json toJson() const;
