@@ -24,7 +24,8 @@ class PhantomCommand : public cli::Command {
   }
   std::string example() const override {
     return "articula phantom -o phantom --seed 3 --model ellipsoid --gap 2\n"
-           "  articula phantom -o pelvis --both-hips --radius-range 17,30 --gap 1.5 --spacing 1.5,1.5,3 --fovea --osteoporotic";
+           "  articula phantom -o pelvis --both-hips --radius-range 17,30 --gap 1.5 --spacing 1.5,1.5,3 --fovea --osteoporotic\n"
+           "  articula phantom -o arthritic --seed 2 --flattened-dome 0.15 --osteophytes 2 --cysts --narrow-gap 0.8";
   }
   void declare(CLI::App& app) override {
     app.add_option("-o,--output", output_, "Output folder (phantom.nii.gz, dicom/, truth.json)")->required();
@@ -58,6 +59,38 @@ class PhantomCommand : public cli::Command {
                  "whose first-order distance makes a 3 mm gap 3.2 mm and a 12 mm wall 16.6 mm on a 21 mm head)");
     app.add_flag("--both-hips", options_.both_hips,
                  "Both hips in one field of view with a pelvis-like frame; --side names the head of the top-level truth");
+    // Arthritis, on the --side head; truth.json's `departures` record each change.
+    app.add_option("--flattened-dome", options_.flattened_dome,
+                   "Arthritis: the head's weight-bearing dome flattened, cut by a plane this FRACTION (0-0.5) of its "
+                   "radius below its top (superior) and covered by new cortex, as a collapsed or worn femoral head")
+        ->capture_default_str();
+    app.add_option("--osteophytes", options_.osteophytes_mm,
+                   "Arthritis: a bony lip of this height (mm, up to 6) along the superior 150 degrees of the "
+                   "head-neck junction, as the osteophytes ringing an arthritic head")
+        ->capture_default_str();
+    app.add_flag("--cysts", options_.cysts,
+                 "Arthritis: three subchondral cysts, fluid-filled balls 2-5 mm across just under the cortex of the "
+                 "superior cap");
+    app.add_option("--narrow-gap", options_.narrow_gap_mm,
+                   "Arthritis: the joint space narrowed to this width (mm, 0.3 up to --gap) over a superior patch of "
+                   "the cap (within 20 degrees of superior, back to --gap at 32), as cartilage loss where the hip "
+                   "bears weight")
+        ->capture_default_str();
+    // What the scan adds; truth.json records each.
+    fov_cut_ = app.add_option("--fov-cut", fov_cut_value_,
+                   "A field of view that clips the --side head: the stored image ends at a plane across --fov-face "
+                   "with the head reaching this FRACTION of its radius beyond the last voxels (0: tangent, up to "
+                   "0.9), as a scan framed too tightly");
+    app.add_option("--fov-face", fov_face_,
+                   "The face of the field of view that --fov-cut moves in: +x, -x, +y, -y, +z, -z (LPS: left, right, "
+                   "posterior, anterior, superior, inferior; or L, R, P, A, S, I)")
+        ->capture_default_str();
+    app.add_option("--metal", metal_,
+                   "Metal on the --side femur: screw (a 6.5 mm lag screw along the neck into the head, as after a "
+                   "fixed neck fracture) or stem (a 12 mm stem in the shaft), at 8000 HU clipped to the scanner's "
+                   "3071, with streaks (bright and dark lines through the metal in each slice) and dark bands "
+                   "along and between its parts")
+        ->check(CLI::IsMember({"screw", "stem"}));
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
@@ -79,6 +112,16 @@ class PhantomCommand : public cli::Command {
     o.fovea = options_.fovea;
     o.both_hips = options_.both_hips;
     o.exact_depth = options_.exact_depth;
+    o.flattened_dome = options_.flattened_dome;
+    o.osteophytes_mm = options_.osteophytes_mm;
+    o.cysts = options_.cysts;
+    o.narrow_gap_mm = options_.narrow_gap_mm;
+    if (!metal_.empty()) o.metal = phantom::metalFromName(metal_);
+    if (fov_cut_->count()) {
+      if (!(fov_cut_value_ >= 0)) throw UsageError("--fov-cut: expected a fraction of the radius from 0 to 0.9");
+      o.fov_cut = fov_cut_value_;
+      o.fov_face = phantom::faceDirection(fov_face_);
+    }
     if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer");
     o.seed = static_cast<unsigned long long>(common.seed);
     if (!model_.empty()) o.model = geometry::modelFromName(model_);
@@ -147,9 +190,11 @@ class PhantomCommand : public cli::Command {
   std::vector<double> radius_range_ = {20.0, 25.0};
   std::string socket_ = "congruent";
   double socket_cortical_hu_ = 0, socket_cancellous_hu_ = 0;
+  double fov_cut_value_ = 0;
+  std::string fov_face_ = "+z", metal_;
   phantom::PhantomOptions options_;  // holds the parsed values of the bone and socket options
   CLI::Option *radius_option_ = nullptr, *cortical_hu_ = nullptr, *cancellous_hu_ = nullptr, *cortical_mm_ = nullptr, *variation_ = nullptr,
-              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr;
+              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr, *fov_cut_ = nullptr;
 };
 
 ARTICULA_REGISTER_COMMAND(PhantomCommand)
