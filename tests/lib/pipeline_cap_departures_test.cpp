@@ -82,7 +82,7 @@ TEST(CapDepartures, AFlattenedDomeIsMeasuredInAreaAndDepth) {
   EXPECT_NEAR(dome.area_mm2, expected, 0.08 * expected);
   EXPECT_GT(dome.direction.z(), 0.99);
   EXPECT_EQ(dome.where, "superior");
-  EXPECT_NEAR(d.largestFindingMm2(), dome.area_mm2, 1e-9);
+  EXPECT_NEAR(d.largestFindingMm2(), dome.area_mm2, 1e-9);  // 2.4 mm deep: a finding
   // Every vertex of the region, and only those, is marked with it: on the plane, deeper than t.
   ASSERT_EQ(d.region_of_vertex.size(), static_cast<size_t>(c.input.vertices.rows()));
   for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v) {
@@ -119,11 +119,14 @@ TEST(CapDepartures, AnOsteophyteOnTheRimIsOutwardAndAPitAtTheMedialPoleIsTheFove
   EXPECT_NEAR(fovea->depth_mm, 2, 0.05);
   EXPECT_NEAR(d.largestFindingMm2(), lip->area_mm2, 1e-9);  // the fovea is anatomy, not a finding
 
-  // Without the hip's medial side, the same pit is an inward departure.
+  // Without the hip's medial side, the same pit is an inward departure,
+  // listed, but at 2 mm deep no finding.
   c.input.medial.reset();
   const CapDepartures unsided = capDepartures(c.input);
   ASSERT_EQ(unsided.regions.size(), 2u);
   for (const auto& r : unsided.regions) EXPECT_NE(r.kind, "fovea");
+  c.bump(Eigen::Vector3d::UnitX(), 5, 0.1);  // 1.9 mm deep
+  EXPECT_NEAR(capDepartures(c.input).largestFindingMm2(), lip->area_mm2, 1.0);
 }
 
 TEST(CapDepartures, ANeckRisingOutOfTheHeadBeyondTheRimIsNoFinding) {

@@ -117,7 +117,7 @@ void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
 double CapDepartures::largestFindingMm2() const {
   double largest = 0;
   for (const auto& r : regions)
-    if (r.kind != "fovea") largest = std::max(largest, r.area_mm2);
+    if (r.kind != "fovea" && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
   return largest;
 }
 

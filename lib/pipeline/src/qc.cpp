@@ -59,9 +59,10 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
 constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
 // The bone departs from the selected model over its cap (cap_departures.hpp):
-// the largest region beyond the threshold, a hip's fovea aside. Warned from
-// 40 mm^2: a dome flattened by a tenth of a 20 mm radius departs over about
-// 125 mm^2, a 3 mm osteophyte over about 50 mm^2.
+// the largest region beyond the threshold and 2 mm deep, a hip's fovea
+// aside. Warned from 40 mm^2: a dome flattened by a tenth of a 20 mm radius
+// departs over about 125 mm^2 (on phantoms 230-320 mm^2 at 10-15 %), a 3 mm
+// lip over 50-90 mm^2.
 constexpr double kDepartureWarnMm2 = 40;
 
 // A yes-or-no check of how the head was found: 1 passes, 0 warns; no doubt
@@ -363,8 +364,8 @@ QcReport checkHead(const HeadQcInput& in) {
   if (in.cap_departure_mm2) {
     // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
     QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
-                            "the bone departs from the selected model over part of its cap: the largest departing "
-                            "region (mm^2, a hip's fovea aside) is");
+                            "the bone departs from the selected model over part of its cap: the largest region "
+                            "departing by 2 mm or more (mm^2, a hip's fovea aside) is");
     departs.of_structure = false;
     if (departs.status == "warn")
       departs.reason += ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone "

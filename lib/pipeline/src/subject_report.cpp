@@ -189,6 +189,7 @@ std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const s
   in.model = model;
   in.points = points::readPoints(folder / "points.ply").positions;
   if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
+  in.ct = ct;
   // LPS: +x is the patient's left, so a right hip's medial side is +x.
   if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
   return capDepartures(in);
