@@ -70,7 +70,8 @@ std::string selectedModels(const std::vector<std::pair<std::string, json>>& resu
 constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left}
 th{background:#f4f4f4}tr.failed td{background:#fde7e9}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}
-figure{margin:.5em 0}figure svg{max-width:100%;height:auto}.note{color:#666;font-size:.9em})";
+figure{margin:.5em 0}figure svg{max-width:100%;height:auto}.note{color:#666;font-size:.9em}
+.scroll{max-height:32em;overflow-y:auto;display:inline-block})";
 
 }  // namespace
 
@@ -100,6 +101,9 @@ std::string studyReportHtml(const json& study, const std::vector<std::pair<std::
     }
   }
   look += "</table>\n";
+  // A cohort's list scrolls within the page; an empty one says so.
+  look = look.find("<tr class=") == std::string::npos ? "<p>None: every subject finished and passed its checks.</p>\n"
+                                                      : "<div class=\"scroll\">" + look + "</div>\n";
   const json& provenance = member(study, "provenance");
   std::ostringstream html;
   html << report::htmlPageStart("articula study", kStyle) << "<h1>articula study</h1>\n<p id=\"counts\">" << subjects.size()
@@ -108,7 +112,7 @@ std::string studyReportHtml(const json& study, const std::vector<std::pair<std::
        << "</span> flagged by their checks.</p>\n<section id=\"look\"><h2>Subjects to look at</h2>\n" << look
        << "</section>\n<section id=\"quantities\"><h2>Across the subjects</h2>\n<p class=\"note\">A dot per subject; a "
           "click opens its page.</p>\n"
-       << plots(results, study_dir, models) << "<h3>Selected models</h3>\n" << selectedModels(results, study_dir, models)
+       << plots(results, study_dir, models) << "<h3>Selected models</h3>\n<div class=\"scroll\">" << selectedModels(results, study_dir, models) << "</div>\n"
        << "</section>\n<section id=\"tables\"><h2>Tables</h2><ul>";
   for (const char* file : {"study.csv", "study_summary.csv", "study_status.csv", "study.json", "study.svg"})
     if (fs::exists(study_dir / file)) html << "<li><a href=\"" << file << "\">" << file << "</a></li>";
