@@ -240,7 +240,7 @@ table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding
 th{background:#f4f4f4}.status{font-size:1.3em}.status.pass{color:#176f2c}.status.warn{color:#a15c00}
 .status.fail{color:#b00020}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}figure{margin:1em 0}
 figure svg{max-width:100%;height:auto}.slices{display:flex;flex-wrap:wrap;gap:.5em}
-.slices figure{margin:0}
+.slices figure{margin:0;max-width:240px}.slices figcaption{font-size:.85em}
 .view3d-controls label{margin-right:1em}.colour-bar{display:flex;align-items:center;gap:.5em;max-width:960px;margin:.3em 0}
 .colour-bar .bar{flex:1;height:12px;border:1px solid #999}.note{color:#666;font-size:.9em}code{font-size:.9em})";
 
