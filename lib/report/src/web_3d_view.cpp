@@ -204,6 +204,7 @@ std::string web3dViewHtml(const View3d& view) {
       "<p class=\"note\">Drag to turn, scroll to zoom, right-drag to pan. Seen from the front, head up. Tick a fitted "
       "surface to show it. Red: where the bone departs from the selected model (see the departures' table). The points are coloured by their signed distance to the chosen model (98 % of them within the bar's range; the rest "
       "saturate).</p>\n"
+      "<style>#view3d-toggles label{white-space:nowrap;margin-right:.8em}</style>\n"
       "<div class=\"view3d-controls\"><span id=\"view3d-toggles\"></span> <label>colour points by <select "
       "id=\"view3d-colouring\"></select></label></div>\n"
       "<canvas id=\"view3d-canvas\" width=\"960\" height=\"600\" style=\"width:100%;max-width:960px;height:600px;"
