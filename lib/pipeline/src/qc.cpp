@@ -373,6 +373,21 @@ QcReport checkHead(const HeadQcInput& in) {
                         "the model describes the rest (see cap_departures in results.json and the slices)";
     report.checks.push_back(departs);
   }
+  if (in.surface_on_ct_edges)
+    report.checks.push_back(flag("surface_on_ct_edges", *in.surface_on_ct_edges,
+                                 "warn when the surface could not be moved onto the CT's bone edges",
+                                 "too few of the surface's vertices found a bone edge in the CT (coarse or lossy voxels, "
+                                 "or not the CT the label was made from): the surface is the label's voxel staircase, "
+                                 "up to half a voxel off the bone"));
+  {
+    // Every warning of a stage is a named check, never a terminal line only.
+    std::string joined;
+    for (const auto& w : in.stage_warnings) joined += (joined.empty() ? "" : "; ") + w;
+    QcCheck warned = flag("stage_warnings", in.stage_warnings.empty(), "warn when a stage warned (0: none)",
+                          "the stages warned: " + joined);
+    warned.value = static_cast<double>(in.stage_warnings.size());
+    report.checks.push_back(warned);
+  }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
     // Femoral heads lie 60-110 mm from the body's middle (half the distance
     // between them), humeral heads 120-190 mm (the glenoids on either side

@@ -118,10 +118,19 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
     in.head_outside_volume_share = headOutsideVolumeShare(ct->geometry, in.points, in.sphere_center, in.sphere_radius_mm);
     in.metal_near_head_mm3 = metalNearHead(*ct, in.sphere_center, in.sphere_radius_mm);
   }
+  const fs::path mesh_summary = folder / "bone.vtp.json";
+  if (fs::exists(mesh_summary)) {
+    const json mesh = readStageJson(mesh_summary);
+    if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("moved") &&
+        mesh.at("ct_edges").at("moved").is_boolean())
+      in.surface_on_ct_edges = mesh.at("ct_edges").at("moved").get<bool>();
+  }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);
     try {
+      for (const auto& w : seg.value("warnings", json::array()))
+        if (w.is_string()) in.stage_warnings.push_back(w.get<std::string>());
       if (seg.contains("head_depth_mm")) in.label_depth_mm = seg.at("head_depth_mm").get<double>();
       if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
         const auto& sc = seg.at("head_center_mm");
