@@ -207,29 +207,12 @@ std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const s
 // The bone's triangles whose corners all lie in one departing region (a
 // fovea aside), for the 3-D view.
 report::ViewSurface departingSurface(const points::MeshFile& bone, const CapDepartures& departures) {
-  std::vector<int> new_index(static_cast<size_t>(bone.vertices.rows()), -1);
-  std::vector<Eigen::Vector3i> kept;
-  int n_vertices = 0;
   const auto region = [&departures](int v) { return departures.region_of_vertex[static_cast<size_t>(v)]; };
-  for (Eigen::Index f = 0; f < bone.triangles.rows(); ++f) {
+  return meshPart(bone, "departing from the model", [&](Eigen::Index f) {
     const int r = region(bone.triangles(f, 0));
-    if (r < 0 || region(bone.triangles(f, 1)) != r || region(bone.triangles(f, 2)) != r ||
-        departures.regions[static_cast<size_t>(r)].kind == "fovea")
-      continue;
-    Eigen::Vector3i t;
-    for (int k = 0; k < 3; ++k) {
-      int& index = new_index[static_cast<size_t>(bone.triangles(f, k))];
-      if (index < 0) index = n_vertices++;
-      t[k] = index;
-    }
-    kept.push_back(t);
-  }
-  report::ViewSurface surface{"departing from the model", Eigen::MatrixX3d(n_vertices, 3),
-                              Eigen::MatrixX3i(static_cast<Eigen::Index>(kept.size()), 3)};
-  for (size_t v = 0; v < new_index.size(); ++v)
-    if (new_index[v] >= 0) surface.vertices.row(new_index[v]) = bone.vertices.row(static_cast<Eigen::Index>(v));
-  for (size_t f = 0; f < kept.size(); ++f) surface.triangles.row(static_cast<Eigen::Index>(f)) = kept[f].transpose();
-  return surface;
+    return r >= 0 && region(bone.triangles(f, 1)) == r && region(bone.triangles(f, 2)) == r &&
+           departures.regions[static_cast<size_t>(r)].kind != "fovea";
+  });
 }
 
 }  // namespace
