@@ -31,6 +31,7 @@
 #include "articula/pipeline/subject_html.hpp"
 #include "articula/points/mesh_file.hpp"
 #include "articula/points/point_io.hpp"
+#include "articula/report/error_map_svg.hpp"
 #include "articula/report/markup_text.hpp"
 
 namespace articula::pipeline {
@@ -376,7 +377,11 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   try {
     report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
     if (bone && departures) view.departures = departingSurface(*bone, *departures);
-    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = report::symmetricColourRange(d.signed_distance_mm);
+    // One colour, one distance: the error maps' scale on the view and in Slicer.
+    std::vector<report::ErrorMapPanel> panels;
+    for (const auto& d : view.distances) panels.push_back({d.model, d.signed_distance_mm});
+    if (!panels.empty()) view.colour_range_mm = report::sharedColourLimit(panels);
+    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = view.colour_range_mm;
     view_html = report::web3dViewHtml(view);
   } catch (const Error& e) {
     view_html = "<section id=\"view3d\"><h2>3-D view</h2><p class=\"note\">No 3-D view: " + report::escapeMarkup(e.what()) +
