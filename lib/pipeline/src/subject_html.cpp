@@ -221,12 +221,18 @@ std::string aboutSection(const json& results, const fs::path& folder) {
   std::string html = "<section id=\"about\"><h2>About</h2>\n<table>";
   html += "<tr><th>articula</th><td>" + report::escapeMarkup(text(provenance, "articula_version")) + " (commit " +
           report::escapeMarkup(text(provenance, "git_commit")) + ")</td></tr>";
-  html += "<tr><th>command</th><td><code>" + report::escapeMarkup(text(provenance, "command")) + "</code></td></tr>";
+  // The command the user typed first; the report stage's own when a run ran it.
+  const std::string invoked_by = text(provenance, "invoked_by");
+  html += "<tr><th>command</th><td><code>" + report::escapeMarkup(invoked_by.empty() ? text(provenance, "command") : invoked_by) +
+          "</code></td></tr>";
+  if (!invoked_by.empty())
+    html += "<tr><th>its report stage</th><td><code>" + report::escapeMarkup(text(provenance, "command")) + "</code></td></tr>";
   html += "<tr><th>written</th><td>" + utcNow() + "</td></tr>";
   html += "<tr><th>input</th><td>" + report::escapeMarkup(results.value("input", "")) + "</td></tr>";
   for (const auto& [key, value] : member(provenance, "parameters").items())
-    html += "<tr><th>" + report::escapeMarkup(key) + "</th><td>" + report::escapeMarkup(value.is_string() ? value.get<std::string>() : value.dump()) +
-            "</td></tr>";
+    if (key != "input")  // shown above
+      html += "<tr><th>" + report::escapeMarkup(key) + "</th><td>" +
+              report::escapeMarkup(value.is_string() ? value.get<std::string>() : value.dump()) + "</td></tr>";
   for (const auto& input : member(provenance, "inputs"))
     html += "<tr><th>SHA-256</th><td>" + report::escapeMarkup(text(input, "path")) + ": <code>" + report::escapeMarkup(text(input, "sha256")) +
             "</code></td></tr>";
@@ -250,7 +256,9 @@ std::string subjectReportHtml(const json& results, const fs::path& folder, const
                               const std::string& view_html) {
   const std::string title = "articula: " + results.value("side", "") + " " + results.value("joint", "") + " head";
   std::string html = report::htmlPageStart(title, kStyle) + "<h1>" + report::escapeMarkup(title) + "</h1>\n<p>" +
-                     report::escapeMarkup(results.value("input", "")) + "</p>\n";
+                     report::escapeMarkup(results.value("input", "")) + "</p>\n";  // A subject of a study (STUDY/subjects/<id>/): the way back to its study page.
+  if (fs::absolute(folder).lexically_normal().parent_path().filename() == "subjects")
+    html += "<p><a href=\"../../study.html\">&larr; the study</a></p>\n";
   html += verdictSection(results);
   html += view_html;
   html += "<section id=\"slices\"><h2>CT through the head</h2>\n<p class=\"note\">The selected model's outline in "
