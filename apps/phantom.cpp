@@ -1,5 +1,6 @@
 // `articula phantom`: writes a synthetic hip CT of known femoral head shape
 // (NIfTI and a DICOM series) with its truth, the default input of the tests.
+#include <cstdio>
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -155,8 +156,11 @@ class PhantomCommand : public cli::Command {
     const std::vector<std::filesystem::path> old_slices = checkOutputs(common.force);
 
     const phantom::Phantom p = phantom::makePhantom(o);
-    log::info("phantom: " + p.truth["model"].get<std::string>() + " head at " + p.truth["head_center_mm"].dump() +
-              " mm, grid " + p.truth["grid"]["size"].dump());
+    const auto& centre = p.truth["head_center_mm"];
+    char at[96];
+    std::snprintf(at, sizeof at, "(%.2f, %.2f, %.2f)", centre[0].get<double>(), centre[1].get<double>(), centre[2].get<double>());
+    log::info("phantom: " + p.truth["model"].get<std::string>() + " head at " + at + " mm (LPS), grid " +
+              p.truth["grid"]["size"].dump());
     imaging::writeVolume(volume_path, p.ct, true);
     imaging::writeLabel(output_ / "femur_truth.nii.gz", p.femur, true);
     if (!no_dicom_) {

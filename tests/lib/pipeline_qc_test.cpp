@@ -51,7 +51,24 @@ TEST(HeadQc, AFemoralHeadsCapPasses) {
   const pipeline::QcReport r = pipeline::checkHead(in);
   EXPECT_EQ(r.status, "pass") << r.toJson().dump();
   EXPECT_TRUE(r.reasons().empty());
-  EXPECT_EQ(r.checks.size(), 6u);
+  EXPECT_EQ(r.checks.size(), 7u);
+  EXPECT_EQ(check(r, "stage_warnings").value, 0);
+}
+
+TEST(HeadQc, AStagesWarningAndASurfaceLeftOnTheLabelAreNamedChecks) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.stage_warnings = {"2 file(s) of ct/ are in no DICOM series", "the search took the larger head"};
+  in.surface_on_ct_edges = false;
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(r.status, "warn");
+  const pipeline::QcCheck& warned = check(r, "stage_warnings");
+  EXPECT_EQ(warned.status, "warn");
+  EXPECT_EQ(warned.value, 2);
+  EXPECT_NE(warned.reason.find("no DICOM series; the search took the larger head"), std::string::npos) << warned.reason;
+  EXPECT_EQ(check(r, "surface_on_ct_edges").status, "warn");
+  EXPECT_NE(check(r, "surface_on_ct_edges").reason.find("voxel staircase"), std::string::npos);
+  // Neither is a doubt about the structure: two of them do not fail the head.
+  EXPECT_FALSE(warned.of_structure);
 }
 
 TEST(HeadQc, ASocketsInnerSurfaceFailsOnItsNormals) {

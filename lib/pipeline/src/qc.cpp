@@ -60,6 +60,12 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // 2,000) within two radii of its centre, warned from 100 mm^3 (a screw of
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
 constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
+// The bone departs from the selected model over its cap (cap_departures.hpp):
+// the largest region beyond the threshold and 2 mm deep, a hip's fovea
+// aside. Warned from 40 mm^2: a dome flattened by a tenth of a 20 mm radius
+// departs over about 125 mm^2 (on phantoms 230-320 mm^2 at 10-15 %), a 3 mm
+// lip over 50-90 mm^2.
+constexpr double kDepartureWarnMm2 = 40;
 // The fitted sphere beyond the field of view on its farthest side, relative
 // to the radius. On the clinical matrix (bench/clinical.sh: 6 heads, each
 // face cut 0, 10, 25 and 50 % of the radius into the head): 0-0.09 at a
@@ -68,7 +74,7 @@ constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
 // every uncut CT. Warned above 0.03: every cut of a tenth of the radius, on
 // the neck's side too, where the share above (its cone about the neck left
 // out) stayed at 0.00-0.08.
-constexpr double kBeyondFovWarn = 0.03;                              // warnings of the structure's checks
+constexpr double kBeyondFovWarn = 0.03;
 
 // A yes-or-no check of how the head was found: 1 passes, 0 warns; no doubt
 // about the structure either way.
@@ -377,6 +383,33 @@ QcReport checkHead(const HeadQcInput& in) {
     if (metal.status == "warn")
       metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
     report.checks.push_back(metal);
+  }
+  if (in.cap_departure_mm2) {
+    // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
+    QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
+                            "the bone departs from the selected model over part of its cap: the largest region "
+                            "departing by 2 mm or more (mm^2, a hip's fovea aside) is");
+    departs.of_structure = false;
+    if (departs.status == "warn")
+      departs.reason += ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone "
+                        "taken in, a slice too many at coarse slices), or a head no model of the hierarchy follows there; "
+                        "the model describes the rest (see cap_departures in results.json and the slices)";
+    report.checks.push_back(departs);
+  }
+  if (in.surface_on_ct_edges)
+    report.checks.push_back(flag("surface_on_ct_edges", *in.surface_on_ct_edges,
+                                 "warn when the surface could not be moved onto the CT's bone edges",
+                                 "too few of the surface's vertices found a bone edge in the CT (coarse or lossy voxels, "
+                                 "or not the CT the label was made from): the surface is the label's voxel staircase, "
+                                 "up to half a voxel off the bone"));
+  {
+    // Every warning of a stage is a named check, never a terminal line only.
+    std::string joined;
+    for (const auto& w : in.stage_warnings) joined += (joined.empty() ? "" : "; ") + w;
+    QcCheck warned = flag("stage_warnings", in.stage_warnings.empty(), "warn when a stage warned (0: none)",
+                          "the stages warned: " + joined);
+    warned.value = static_cast<double>(in.stage_warnings.size());
+    report.checks.push_back(warned);
   }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
     // Femoral heads lie 60-110 mm from the body's middle (half the distance

@@ -6,7 +6,9 @@
 //                      it is best (by RMS, AIC, BIC), mean AIC/BIC difference to
 //                      the sphere, and the paired Wilcoxon signed-rank p-value of
 //                      its RMS against the sphere's
-//   study_status.csv   one row per subject: status, exit code, message
+//   study_status.csv   one row per subject: status, exit code, message, and
+//                      the reviewer's decision and note (ratings.hpp); the
+//                      tables above leave the excluded subjects out
 //   study.json         all of the above, with provenance
 //   study.svg          RMS per model for each subject, with the per-model means
 //                      (when at least one subject succeeded)
