@@ -136,7 +136,7 @@ class FitCommand : public cli::Command {
                           {"input", input_.string()},
                           {"n_points", cloud.positions.rows()},
                           {"objective", objective_},
-                          {"best_model", summary.best_model},
+                          {"least_rms_model", summary.best_model},
                           {"seconds", summary.seconds},
                           {"models", models},
                           {"provenance", provenanceJson({params, {input_}, common.seed})}};
@@ -144,7 +144,7 @@ class FitCommand : public cli::Command {
     writeFileAtomically(output_, doc.dump(2) + "\n", common.force);
     writeFileAtomically(csv, fitsCsv(summary), common.force);
     if (common.json)
-      cli::printJson({{"output", output_.string()}, {"csv", csv.string()}, {"best_model", summary.best_model},
+      cli::printJson({{"output", output_.string()}, {"csv", csv.string()}, {"least_rms_model", summary.best_model},
                       {"seconds", summary.seconds}});
     return 0;
   }

@@ -13,6 +13,8 @@ PACKAGES=(
   build-essential cmake git pkg-config libssl-dev
   libinsighttoolkit5-dev libvtk9-dev libcgal-dev libeigen3-dev
   libnlopt-cxx-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
+  # the distributions of the model selection's tests (Boost.Math, headers)
+  libboost-dev
   # the multibody engine of lib/dynamics
   libsimbody-dev
   # the reports' 3-D view, inlined at build time

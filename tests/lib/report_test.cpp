@@ -163,7 +163,7 @@ TEST(ErrorMapSvg, OneDotPerPointColouredByDistance) {
   EXPECT_NE(svg.find(">-0.5</text>"), std::string::npos);
   EXPECT_NE(svg.find(">0.5</text>"), std::string::npos);
   EXPECT_NE(svg.find("signed distance (mm)"), std::string::npos);
-  EXPECT_NE(svg.find("superovoid: RMS 0.05 mm (best)"), std::string::npos);
+  EXPECT_NE(svg.find("superovoid: RMS 0.05 mm (least RMS)"), std::string::npos);
   EXPECT_NE(svg.find("x (mm) \u2192 P"), std::string::npos);
   EXPECT_NE(svg.find("y (mm) \u2192 S"), std::string::npos);
   EXPECT_NE(svg.find("LPS"), std::string::npos);

@@ -61,7 +61,7 @@ const std::vector<StageDescription>& stages() {
        2, 1000},
       {"report",
        "Results, the selected model and the head's checks from the stage outputs",
-       {"series-uid", "selection-tolerance", "selection-floor"},
+       {"series-uid", "selection-alpha"},
        {"fits.json", "errors/summary.json", "points.ply", "bone.vtp"},
        {"results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"},
        {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"},

@@ -1,6 +1,7 @@
 #include "articula/pipeline/study_html.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -36,8 +37,10 @@ std::string plots(const std::vector<std::pair<std::string, json>>& results, cons
                   const std::vector<std::string>& models) {
   std::vector<Quantity> quantities;
   for (const auto& model : models) quantities.push_back({"RMS of the " + model, "mm", model, "rms_mm"});
+  // Semi-axes, not raw radii: an ovoid's a shares its scale with c0x, and
+  // only a c0x, its semi-axis, is what the points determine.
   for (const char* axis : {"a", "b", "c"})
-    quantities.push_back({std::string("Radius ") + axis + " of the selected model", "mm", "", std::string(axis) + "_mm"});
+    quantities.push_back({std::string("Semi-axis ") + axis + " of the selected model", "mm", "", std::string("semi_axis_") + axis});
   for (const char* exponent : {"gamma1", "gamma2", "gamma3"})
     quantities.push_back({std::string("Superellipsoid exponent ") + exponent, "", "superellipsoid", exponent});
   std::string html;
@@ -45,13 +48,42 @@ std::string plots(const std::vector<std::pair<std::string, json>>& results, cons
     std::vector<report::StripPoint> points;
     for (const auto& [id, r] : results) {
       const json* m = modelNamed(r, q.model.empty() ? text(r, "selected_model") : q.model);
-      const double v = !m ? NAN : q.parameter == "rms_mm" ? numberAt(member(*m, "errors"), "rms_mm")
-                                                          : numberAt(member(*m, "parameters"), q.parameter);
+      double v = NAN;
+      if (m && q.parameter == "rms_mm") v = numberAt(member(*m, "errors"), "rms_mm");
+      else if (m && q.parameter.rfind("semi_axis_", 0) == 0) {
+        const json& axes = member(*m, "semi_axes_mm");
+        const size_t k = static_cast<size_t>(q.parameter.back() - 'a');
+        if (axes.is_array() && k < axes.size() && axes[k].is_number()) v = axes[k].get<double>();
+      } else if (m) {
+        v = numberAt(member(*m, "parameters"), q.parameter);
+      }
       points.push_back({id, v, subjectLink(study_dir, id)});
     }
     html += "<figure>" + report::stripPlotSvg(q.title, q.unit, points) + "</figure>\n";
   }
   return html;
+}
+
+// Per step of the hierarchy: the subjects whose own test needs the richer
+// model, and the cohort's tests (study.json "steps").
+std::string cohortSteps(const json& study) {
+  std::string html = "<table id=\"cohort-steps\"><tr><th>step</th><th>subjects</th><th>richer model needed</th>"
+                     "<th>Fisher's combined p</th><th>sign test p (a majority needs it)</th></tr>\n";
+  const auto p_text = [](const json& v) {
+    if (!v.is_number()) return std::string("-");
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3g", v.get<double>());
+    return std::string(buffer);
+  };
+  for (const auto& st : member(study, "steps"))
+    html += "<tr><td>" + escapeMarkup(text(st, "simpler")) + " &rarr; " + escapeMarkup(text(st, "richer")) + "</td><td>" +
+            text(st, "subjects") + "</td><td>" + text(st, "richer_needed") + "</td><td>" + p_text(member(st, "fisher_p")) +
+            "</td><td>" + p_text(member(st, "sign_test_p")) + "</td></tr>\n";
+  return html + "</table>\n<p class=\"note\">Each subject's step is its nested F test with its residuals' "
+                "effective number of independent points (results.json, selection.steps). Fisher's method asks whether "
+                "any subject needs the richer model and is carried by single extreme subjects; the sign test asks "
+                "whether a majority does and cannot fall below 0.05 with fewer than 5 subjects. Both take the subjects "
+                "as independent.</p>\n";
 }
 
 std::string selectedModels(const std::vector<std::pair<std::string, json>>& results, const fs::path& study_dir,
@@ -175,8 +207,9 @@ std::string studyReportHtml(const json& study, const std::vector<std::pair<std::
        << "</section>\n<section id=\"quantities\"><h2>Across the subjects</h2>\n<p class=\"note\">A dot per subject; a "
           "click opens its page.</p>\n"
        << plots(results, study_dir, models) << "<h3>Selected models</h3>\n<div class=\"scroll\">" << selectedModels(results, study_dir, models) << "</div>\n"
+       << "<h3>Which steps of the hierarchy the cohort needs</h3>\n" << cohortSteps(study)
        << "</section>\n" << reviewSection(subjects) << "<section id=\"tables\"><h2>Tables</h2><ul>";
-  for (const char* file : {"study.csv", "study_summary.csv", "study_status.csv", "study.json", "study.svg", "ratings.csv"})
+  for (const char* file : {"study.csv", "study_summary.csv", "study_steps.csv", "study_status.csv", "study.json", "study.svg", "ratings.csv"})
     if (fs::exists(study_dir / file)) html << "<li><a href=\"" << file << "\">" << file << "</a></li>";
   html << "</ul></section>\n<section id=\"about\"><h2>About</h2><table><tr><th>articula</th><td>"
        << escapeMarkup(text(provenance, "articula_version")) << " (commit " << escapeMarkup(text(provenance, "git_commit"))

@@ -107,7 +107,7 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
     const bool best = !options.highlight.empty() && panel.label == options.highlight;
     out << "<g class=\"panel\">\n<text x=\"" << x0 + side / 2 << "\" y=\"" << y0 - 10 << "\" text-anchor=\"middle\""
         << (best ? " font-weight=\"bold\"" : "") << ">" << escapeMarkup(panel.label) << ": RMS "
-        << svg::label(n ? std::sqrt(sse / static_cast<double>(n)) : 0.0) << " mm" << (best ? " (best)" : "")
+        << svg::label(n ? std::sqrt(sse / static_cast<double>(n)) : 0.0) << " mm" << (best ? " (least RMS)" : "")
         << "</text>\n<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << side << "\" height=\"" << side
         << "\" fill=\"none\" stroke=\"black\"/>\n";
     for (double t = -extent; t <= extent + 1e-9; t += tick)
