@@ -173,7 +173,7 @@ class ErrorsCommand : public cli::Command {
       file.commit();
     }
     writeFileAtomically(output_ / "histogram.svg",
-                        report::histogramSvg(series, "Signed Euclidean distances: " + input_.filename().string()),
+                        report::histogramSvg(series, "Signed Euclidean distances of the points to each model"),
                         overwrite);
     // Maps about the least-RMS model's centre (fits.json's least_rms_model, or
     // best_model in files before it, else the least RMS here).
@@ -189,7 +189,7 @@ class ErrorsCommand : public cli::Command {
     map_options.highlight = rows[best].model;
     writeFileAtomically(output_ / "error_map.svg",
                         report::errorMapSvg(report::azimuthalEqualArea(P, shapes[best].center), panels, map_options,
-                                            "Signed distances to the fitted surfaces: " + input_.filename().string()),
+                                            "Signed distances to the fitted surfaces"),
                         overwrite);
     // Last: summary.json, then the marker goes: the folder is complete.
     writeFileAtomically(output_ / "summary.json",

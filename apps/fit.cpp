@@ -122,7 +122,9 @@ class FitCommand : public cli::Command {
     points::checkFittable(cloud, geometry::parameterCount(ShapeModel::Superovoid), input_.string());
     log::info("fitting " + std::to_string(cloud.positions.rows()) + " points from " + input_.string());
     const fit::Summary summary = fit::fitHierarchy(cloud.positions, o);
-    log::info(summary.fullReport());
+    // One line by default; each model's start and termination with -v.
+    log::info(summary.briefReport());
+    log::debug(summary.fullReport());
 
     nlohmann::json models = nlohmann::json::array();
     for (const auto& f : summary.fits) models.push_back(fit::modelFitJson(f));

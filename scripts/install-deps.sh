@@ -29,8 +29,9 @@ DEVELOPMENT_PACKAGES=(
   chromium python3-jsonschema
   # the independent hip phantoms of the tests and bench/
   python3-numpy python3-scipy
-  # studies that outgrow one machine (pipelines/Snakefile)
-  snakemake
+  # studies that outgrow one machine (pipelines/Snakefile), and the
+  # single-node Slurm cluster its Slurm profile is tested on (tests/apps/slurm.sh)
+  snakemake slurmctld slurmd slurm-client munge
   # the sanitizer tier and fuzzing (scripts/sanitize.sh, scripts/fuzz.sh):
   # Clang and its libFuzzer runtime
   clang libclang-rt-14-dev

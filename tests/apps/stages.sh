@@ -65,11 +65,20 @@ assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
 assert not re.search(r'<(link|img|iframe)\b|<script[^>]*\bsrc\b', html), "external content"
 assert "content=\"default-src 'none';" in html, "no content security policy"
 assert not re.search(r'\b(src|href)\s*=\s*"(?!#|data:image/png;base64,)', html), "a reference leaves the page"
-# Three CT slices through the head, each an embedded PNG with the label's edge and the model's outline.
+# Nine CT slices, three per plane (through the centre and half a radius to
+# either side), each an embedded PNG with the label's edge and the model's
+# outline, orientation letters, a 10 mm scale bar and its position.
 import base64, struct
 slices = re.findall(r'<svg[^>]*class="slice" data-plane="(\w+)".*?href="data:image/png;base64,([^"]+)".*?'
                     r'class="label-edge" d="([^"]*)".*?class="model-outline" d="([^"]*)"', html, re.S)
-assert [s[0] for s in slices] == ["axial", "coronal", "sagittal"], [s[0] for s in slices]
+assert [s[0] for s in slices] == ["axial"] * 3 + ["coronal"] * 3 + ["sagittal"] * 3, [s[0] for s in slices]
+letters = re.findall(r'<g class="orientation"[^>]*>(.*?)</g>', html)
+assert len(letters) == 9 and all(re.findall(r">([A-Z])</text>", g) for g in letters), letters[:1]
+assert re.findall(r">([A-Z])</text>", letters[0]) == ["R", "L", "A", "P"], letters[0]
+assert re.findall(r">([A-Z])</text>", letters[8]) == ["A", "P", "S", "I"], letters[8]
+assert html.count('class="scale-bar"') == 9 and ">10 mm</text>" in html
+captions = re.findall(r"<figcaption>((?:axial|coronal|sagittal)[^<]*)</figcaption>", html)
+assert len(captions) == 9 and captions[1].startswith("axial, z = ") and captions[1].endswith("(centre)"), captions
 for plane, png, edge, outline in slices:
     png = base64.b64decode(png)
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR", plane

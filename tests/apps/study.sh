@@ -156,6 +156,26 @@ if command -v snakemake > /dev/null; then
   cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-again/subjects/p2/points.ply" || fail "same seed, different points"
   cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-again/subjects/p2/results.csv" || fail "same seed, different fits"
   cmp "$tmp/batch-good/subjects/p2/results.csv" "$tmp/snake/subjects/p2/results.csv" || fail "snakemake and batch, different fits"
+  # A reviewer excludes p1 (ratings.csv in the study folder): the Snakefile
+  # gathers the study again, and batch --gather-only gives the same tables.
+  printf 'subject,decision,note\np1,exclude,"motion, rescanned"\np2,include,\n' | tee "$tmp/snake/ratings.csv" \
+    > "$tmp/batch-good/ratings.csv"
+  snakemake -s "$src/pipelines/Snakefile" --profile "$src/pipelines/profiles/local" --quiet \
+    --config manifest="$tmp/good.csv" study="$tmp/snake" bin="$bin" > "$tmp/snake-rated.log" 2>&1 ||
+    { tail -30 "$tmp/snake-rated.log" >&2; fail "snakemake after the ratings"; }
+  "$bin/articula" batch "$tmp/good.csv" -o "$tmp/batch-good" --gather-only --quiet
+  diff "$tmp/batch-good/study.csv" "$tmp/snake/study.csv" || fail "rated: snakemake study.csv differs from batch"
+  ! grep -q '^p1,' "$tmp/snake/study.csv" || fail "the excluded p1 is still in study.csv"
+  grep -q '^p2,' "$tmp/snake/study.csv" || fail "p2 is missing from study.csv"
+  grep -q '^p1,ok,0,.*,exclude,"motion, rescanned"$' "$tmp/snake/study_status.csv" ||
+    fail "study_status.csv does not record the exclusion: $(cat "$tmp/snake/study_status.csv")"
+  grep -q '"excluded": 1' "$tmp/snake/study.json" || fail "study.json does not count the excluded"
+  grep -q '<td>p1</td><td>motion, rescanned</td>' "$tmp/snake/study.html" || fail "study.html does not list p1 as excluded"
+  # A decision the study does not know: refused, the line named.
+  printf 'subject,decision,note\np1,maybe,\n' > "$tmp/batch-good/ratings.csv"
+  expect_rc 3 "$bin/articula" batch "$tmp/good.csv" -o "$tmp/batch-good" --gather-only
+  grep -q "ratings.csv' line 2: expected the decision include or exclude, found 'maybe'" "$tmp/err" ||
+    fail "a bad decision: $(cat "$tmp/err")"
 else
   echo "snakemake not installed: Snakemake comparison skipped" >&2
 fi

@@ -11,6 +11,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/csv.hpp"
+#include "articula/pipeline/ratings.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/study_html.hpp"
 #include "articula/report/study_svg.hpp"
@@ -90,9 +91,14 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   std::vector<ModelRow> rows;
   std::vector<std::string> parameter_columns;  // union, in order of first appearance
   std::vector<std::string> model_order;
-  std::vector<std::pair<std::string, nlohmann::json>> finished;  // results.json of each finished subject
+  std::vector<std::pair<std::string, nlohmann::json>> finished;  // results.json of each finished subject kept
+  const std::map<std::string, Rating> ratings = readRatings(study_dir, subjects);
+  const auto excluded = [&ratings](const std::string& id) {
+    const auto it = ratings.find(id);
+    return it != ratings.end() && it->second.decision == "exclude";
+  };
   for (size_t i = 0; i < subjects.size(); ++i) {
-    if (batch.outcomes[i].status != "ok") continue;
+    if (batch.outcomes[i].status != "ok" || excluded(subjects[i].id)) continue;
     const fs::path path = subjectDir(study_dir, subjects[i].id) / "results.json";
     const nlohmann::json& results =
         finished.emplace_back(subjects[i].id, readJsonFile(path, "study (" + subjects[i].id + ")")).second;
@@ -253,16 +259,25 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
                           {"sign_test_p", std::isfinite(c.sign_test_p) ? nlohmann::json(c.sign_test_p) : nlohmann::json()}});
   }
 
-  std::string status_csv = csvLine({"subject", "status", "exit_code", "seconds", "message"}) + "\n";
+  std::string status_csv =
+      csvLine({"subject", "status", "exit_code", "seconds", "message", "review", "review_note"}) + "\n";
   nlohmann::json status_json = nlohmann::json::array();
+  int n_excluded = 0;
   for (size_t i = 0; i < subjects.size(); ++i) {
     const auto& o = batch.outcomes[i];
-    status_csv += csvLine({o.id, o.status, std::to_string(o.exit_code), number(o.seconds), o.message}) + "\n";
+    const auto rating = ratings.find(o.id);
+    const Rating review = rating == ratings.end() ? Rating{} : rating->second;
+    n_excluded += review.decision == "exclude";
+    status_csv += csvLine({o.id, o.status, std::to_string(o.exit_code), number(o.seconds), o.message, review.decision,
+                           review.note}) +
+                  "\n";
     status_json.push_back({{"subject", o.id},
                            {"status", o.status},
                            {"exit_code", o.exit_code},
                            {"message", o.message},
-                           {"resumed", o.resumed}});
+                           {"resumed", o.resumed},
+                           {"review", review.decision},
+                           {"review_note", review.note}});
   }
 
   nlohmann::json study = {{"subjects", status_json},
@@ -270,6 +285,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
                           {"steps", steps_json},
                           {"succeeded", batch.succeeded},
                           {"failed", batch.failed},
+                          {"excluded", n_excluded},
                           {"coordinate_system", "LPS"},
                           {"units", "mm"},
                           {"provenance", provenance}};

@@ -99,10 +99,72 @@ std::string selectedModels(const std::vector<std::pair<std::string, json>>& resu
   return html + "</table>\n";
 }
 
+// The reviewer's desk: a decision (include or exclude) and a note per
+// subject, saved as ratings.csv (pipeline/ratings.hpp) from the page itself,
+// offline: the browser downloads the file, which the reviewer moves into the
+// study folder; the tables are then gathered again without the excluded.
+constexpr const char* kReviewScript = R"JS(
+(function () {
+  var rows = document.querySelectorAll('#review tr[data-subject]');
+  var text = document.getElementById('ratings-csv');
+  function field(v) { return /[",\n\r]/.test(v) ? '"' + v.replace(/"/g, '""') + '"' : v; }
+  function csv() {
+    var lines = ['subject,decision,note'];
+    rows.forEach(function (row) {
+      var decision = row.querySelector('select').value, note = row.querySelector('input').value;
+      if (decision) lines.push([row.getAttribute('data-subject'), decision, note].map(field).join(','));
+    });
+    return lines.join('\n') + '\n';
+  }
+  function update() { text.textContent = text.value = csv(); }
+  rows.forEach(function (row) {
+    row.querySelector('select').addEventListener('change', update);
+    row.querySelector('input').addEventListener('input', update);
+  });
+  document.getElementById('save-ratings').addEventListener('click', function () {
+    var a = document.createElement('a');
+    a.href = URL.createObjectURL(new Blob([csv()], {type: 'text/csv'}));
+    a.download = 'ratings.csv';
+    document.body.appendChild(a);
+    a.click();
+    a.remove();
+  });
+  update();
+})();
+)JS";
+
+std::string reviewSection(const json& subjects) {
+  std::string excluded, desk;
+  for (const auto& s : subjects) {
+    const std::string id = text(s, "subject"), decision = text(s, "review"), note = text(s, "review_note");
+    if (decision == "exclude")
+      excluded += "<tr><td>" + escapeMarkup(id) + "</td><td>" + escapeMarkup(note) + "</td></tr>\n";
+    desk += "<tr data-subject=\"" + escapeMarkup(id) + "\"><td>" + escapeMarkup(id) + "</td><td>" + escapeMarkup(text(s, "status")) +
+            "</td><td><select><option value=\"\"" + (decision.empty() ? " selected" : "") +
+            ">not rated</option><option value=\"include\"" + (decision == "include" ? " selected" : "") +
+            ">include</option><option value=\"exclude\"" + (decision == "exclude" ? " selected" : "") +
+            ">exclude</option></select></td><td><input type=\"text\" size=\"40\" value=\"" + escapeMarkup(note) +
+            "\"></td></tr>\n";
+  }
+  std::string html = "<section id=\"excluded\"><h2>Excluded by the reviewer</h2>\n";
+  html += excluded.empty() ? "<p>None.</p>\n"
+                           : "<p class=\"note\">Left out of every table and plot of this page (ratings.csv).</p>\n<div "
+                             "class=\"scroll\"><table><tr><th>subject</th><th>note</th></tr>\n" + excluded + "</table></div>\n";
+  html += "</section>\n<section id=\"review\"><h2>Review</h2>\n<p class=\"note\">Include or exclude a subject, with a "
+          "note; then save ratings.csv into this study's folder and gather the study again (<code>articula batch "
+          "MANIFEST -o STUDY --gather-only</code>, or the Snakefile again): the tables and this page leave the excluded "
+          "out and list them above.</p>\n<div class=\"scroll\"><table><tr><th>subject</th><th>status</th><th>decision</th>"
+          "<th>note</th></tr>\n" + desk + "</table></div>\n<p><button id=\"save-ratings\" type=\"button\">Save ratings.csv"
+          "</button></p>\n<textarea id=\"ratings-csv\" rows=\"6\" cols=\"80\" readonly></textarea>\n<script>" +
+          kReviewScript + "</script>\n</section>\n";
+  return html;
+}
+
 constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left}
 th{background:#f4f4f4}tr.failed td{background:#fde7e9}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}
-figure{margin:.5em 0}figure svg{max-width:100%;height:auto}.note{color:#666;font-size:.9em})";
+figure{margin:.5em 0}figure svg{max-width:100%;height:auto}.note{color:#666;font-size:.9em}
+.scroll{max-height:32em;overflow-y:auto;display:inline-block})";
 
 }  // namespace
 
@@ -132,18 +194,22 @@ std::string studyReportHtml(const json& study, const std::vector<std::pair<std::
     }
   }
   look += "</table>\n";
+  // A cohort's list scrolls within the page; an empty one says so.
+  look = look.find("<tr class=") == std::string::npos ? "<p>None: every subject finished and passed its checks.</p>\n"
+                                                      : "<div class=\"scroll\">" + look + "</div>\n";
   const json& provenance = member(study, "provenance");
   std::ostringstream html;
   html << report::htmlPageStart("articula study", kStyle) << "<h1>articula study</h1>\n<p id=\"counts\">" << subjects.size()
        << " subjects: <span id=\"succeeded\">" << numberAt(study, "succeeded") << "</span> finished, <span id=\"failed\">"
        << numberAt(study, "failed") << "</span> failed, <span id=\"flagged\">" << flagged
-       << "</span> flagged by their checks.</p>\n<section id=\"look\"><h2>Subjects to look at</h2>\n" << look
+       << "</span> flagged by their checks, <span id=\"excluded-count\">" << numberAt(study, "excluded")
+       << "</span> excluded by the reviewer.</p>\n<section id=\"look\"><h2>Subjects to look at</h2>\n" << look
        << "</section>\n<section id=\"quantities\"><h2>Across the subjects</h2>\n<p class=\"note\">A dot per subject; a "
           "click opens its page.</p>\n"
-       << plots(results, study_dir, models) << "<h3>Selected models</h3>\n" << selectedModels(results, study_dir, models)
+       << plots(results, study_dir, models) << "<h3>Selected models</h3>\n<div class=\"scroll\">" << selectedModels(results, study_dir, models) << "</div>\n"
        << "<h3>Which steps of the hierarchy the cohort needs</h3>\n" << cohortSteps(study)
-       << "</section>\n<section id=\"tables\"><h2>Tables</h2><ul>";
-  for (const char* file : {"study.csv", "study_summary.csv", "study_steps.csv", "study_status.csv", "study.json", "study.svg"})
+       << "</section>\n" << reviewSection(subjects) << "<section id=\"tables\"><h2>Tables</h2><ul>";
+  for (const char* file : {"study.csv", "study_summary.csv", "study_steps.csv", "study_status.csv", "study.json", "study.svg", "ratings.csv"})
     if (fs::exists(study_dir / file)) html << "<li><a href=\"" << file << "\">" << file << "</a></li>";
   html << "</ul></section>\n<section id=\"about\"><h2>About</h2><table><tr><th>articula</th><td>"
        << escapeMarkup(text(provenance, "articula_version")) << " (commit " << escapeMarkup(text(provenance, "git_commit"))

@@ -148,6 +148,35 @@ std::string checksSection(const json& results) {
   return html + "</table></section>\n";
 }
 
+// What the articular selection left out: where the bone departs from the
+// selected model over its cap (results.json's cap_departures).
+std::string departuresSection(const json& results) {
+  const json& d = member(results, "cap_departures");
+  if (!d.is_object()) return "";
+  std::string html = "<section id=\"departures\"><h2>Where the bone departs from the model</h2>\n<p class=\"note\">The bone's "
+                     "surface over the articular cap and its rim, measured against the selected model: regions beyond " +
+                     fixed(numberAt(d, "threshold_mm"), 2) + " mm (the largest of 0.75 mm, three times the points' scatter and 0.3 voxel) and of " +
+                     fixed(numberAt(d, "min_region_mm2"), 0) + " mm&sup2; or more. The points leave them out, so the model "
+                     "describes the rest of the cap. Landmarks departure_1, ... in head.mrk.json; red in the 3-D view.</p>\n";
+  const json& regions = member(d, "regions");
+  if (!regions.is_array() || regions.empty()) return html + "<p>None: the bone follows the model over the cap.</p></section>\n";
+  html += "<table><tr><th>region</th><th>kind</th><th>area (mm&sup2;)</th><th>depth (mm)</th><th>where</th>"
+          "<th>centre (LPS mm)</th></tr>\n";
+  int k = 0;
+  for (const auto& r : regions) {
+    const json& centre = member(r, "centre_mm");
+    std::string at;
+    for (int i = 0; i < 3 && centre.is_array() && centre.size() == 3; ++i)
+      at += (i ? ", " : "") + fixed(centre[static_cast<size_t>(i)].is_number() ? centre[static_cast<size_t>(i)].get<double>() : NAN, 1);
+    const std::string kind = text(r, "kind");
+    html += "<tr><td>departure_" + std::to_string(++k) + "</td><td>" +
+            report::escapeMarkup(kind == "fovea" ? "fovea (a pit at the medial pole: anatomy)" : kind) + "</td><td>" +
+            fixed(numberAt(r, "area_mm2"), 0) + "</td><td>" + fixed(numberAt(r, "depth_mm"), 1) + "</td><td>" +
+            report::escapeMarkup(text(r, "where")) + "</td><td>" + at + "</td></tr>\n";
+  }
+  return html + "</table></section>\n";
+}
+
 // A p-value to three significant digits.
 std::string probability(double p) {
   if (!std::isfinite(p)) return "-";
@@ -270,12 +299,18 @@ std::string aboutSection(const json& results, const fs::path& folder) {
   std::string html = "<section id=\"about\"><h2>About</h2>\n<table>";
   html += "<tr><th>articula</th><td>" + report::escapeMarkup(text(provenance, "articula_version")) + " (commit " +
           report::escapeMarkup(text(provenance, "git_commit")) + ")</td></tr>";
-  html += "<tr><th>command</th><td><code>" + report::escapeMarkup(text(provenance, "command")) + "</code></td></tr>";
+  // The command the user typed first; the report stage's own when a run ran it.
+  const std::string invoked_by = text(provenance, "invoked_by");
+  html += "<tr><th>command</th><td><code>" + report::escapeMarkup(invoked_by.empty() ? text(provenance, "command") : invoked_by) +
+          "</code></td></tr>";
+  if (!invoked_by.empty())
+    html += "<tr><th>its report stage</th><td><code>" + report::escapeMarkup(text(provenance, "command")) + "</code></td></tr>";
   html += "<tr><th>written</th><td>" + utcNow() + "</td></tr>";
   html += "<tr><th>input</th><td>" + report::escapeMarkup(results.value("input", "")) + "</td></tr>";
   for (const auto& [key, value] : member(provenance, "parameters").items())
-    html += "<tr><th>" + report::escapeMarkup(key) + "</th><td>" + report::escapeMarkup(value.is_string() ? value.get<std::string>() : value.dump()) +
-            "</td></tr>";
+    if (key != "input")  // shown above
+      html += "<tr><th>" + report::escapeMarkup(key) + "</th><td>" +
+              report::escapeMarkup(value.is_string() ? value.get<std::string>() : value.dump()) + "</td></tr>";
   for (const auto& input : member(provenance, "inputs"))
     html += "<tr><th>SHA-256</th><td>" + report::escapeMarkup(text(input, "path")) + ": <code>" + report::escapeMarkup(text(input, "sha256")) +
             "</code></td></tr>";
@@ -289,7 +324,7 @@ table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding
 th{background:#f4f4f4}.status{font-size:1.3em}.status.pass{color:#176f2c}.status.warn{color:#a15c00}
 .status.fail{color:#b00020}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}figure{margin:1em 0}
 figure svg{max-width:100%;height:auto}.slices{display:flex;flex-wrap:wrap;gap:.5em}
-.slices figure{margin:0}
+.slices figure{margin:0;max-width:240px}.slices figcaption{font-size:.85em}
 .view3d-controls label{margin-right:1em}.colour-bar{display:flex;align-items:center;gap:.5em;max-width:960px;margin:.3em 0}
 .colour-bar .bar{flex:1;height:12px;border:1px solid #999}.note{color:#666;font-size:.9em}code{font-size:.9em})";
 
@@ -299,13 +334,16 @@ std::string subjectReportHtml(const json& results, const fs::path& folder, const
                               const std::string& view_html) {
   const std::string title = "articula: " + results.value("side", "") + " " + results.value("joint", "") + " head";
   std::string html = report::htmlPageStart(title, kStyle) + "<h1>" + report::escapeMarkup(title) + "</h1>\n<p>" +
-                     report::escapeMarkup(results.value("input", "")) + "</p>\n";
+                     report::escapeMarkup(results.value("input", "")) + "</p>\n";  // A subject of a study (STUDY/subjects/<id>/): the way back to its study page.
+  if (fs::absolute(folder).lexically_normal().parent_path().filename() == "subjects")
+    html += "<p><a href=\"../../study.html\">&larr; the study</a></p>\n";
   html += verdictSection(results);
   html += view_html;
   html += "<section id=\"slices\"><h2>CT through the head</h2>\n<p class=\"note\">The selected model's outline in "
           "magenta, the segmentation's edge in yellow; radiological view (the patient's left on the right).</p>\n" +
           slices_html + "</section>\n";
   html += checksSection(results);
+  html += departuresSection(results);
   html += modelsSection(results);
   html += "<section id=\"errors\"><h2>Signed distances of the points to each model</h2>\n" +
           inlineSvg(folder / "errors" / "histogram.svg") + "\n" + inlineSvg(folder / "errors" / "error_map.svg") +

@@ -20,6 +20,7 @@
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/shape.hpp"
 #include "articula/core/csv.hpp"
+#include "articula/pipeline/cap_departures.hpp"
 #include "articula/pipeline/markups.hpp"
 #include "articula/imaging/edges.hpp"
 #include "articula/imaging/io.hpp"
@@ -28,7 +29,9 @@
 #include "articula/pipeline/slicer_scene.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
+#include "articula/points/mesh_file.hpp"
 #include "articula/points/point_io.hpp"
+#include "articula/report/error_map_svg.hpp"
 #include "articula/report/markup_text.hpp"
 
 namespace articula::pipeline {
@@ -89,8 +92,10 @@ json readStageJson(const fs::path& path) {
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
 QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
-                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct) {
+                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct,
+                          const std::optional<CapDepartures>& departures) {
   HeadQcInput in;
+  if (departures) in.cap_departure_mm2 = departures->largestFindingMm2();
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
@@ -114,11 +119,21 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
   if (ct) {
     in.head_outside_volume_share = headOutsideVolumeShare(ct->geometry, in.points, in.sphere_center, in.sphere_radius_mm);
     in.metal_near_head_mm3 = metalNearHead(*ct, in.sphere_center, in.sphere_radius_mm);
+    in.head_beyond_fov_mm = headBeyondFieldOfView(ct->geometry, in.sphere_center, in.sphere_radius_mm);
+  }
+  const fs::path mesh_summary = folder / "bone.vtp.json";
+  if (fs::exists(mesh_summary)) {
+    const json mesh = readStageJson(mesh_summary);
+    if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("moved") &&
+        mesh.at("ct_edges").at("moved").is_boolean())
+      in.surface_on_ct_edges = mesh.at("ct_edges").at("moved").get<bool>();
   }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);
     try {
+      for (const auto& w : seg.value("warnings", json::array()))
+        if (w.is_string()) in.stage_warnings.push_back(w.get<std::string>());
       if (seg.contains("head_depth_mm")) in.label_depth_mm = seg.at("head_depth_mm").get<double>();
       if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
         const auto& sc = seg.at("head_center_mm");
@@ -171,6 +186,36 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volu
   } catch (const Error& e) {
     return "<p class=\"note\">No CT slices: " + report::escapeMarkup(e.what()) + "</p>";
   }
+}
+
+// Where the bone's mesh departs from the selected model over the cap
+// (pipeline/cap_departures.hpp); none without the mesh.
+std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const std::optional<points::MeshFile>& bone,
+                                                 const geometry::ShapeParameters& model, const imaging::Volume* ct,
+                                                 const std::string& joint, const std::string& side) {
+  if (!bone) return std::nullopt;
+  const points::MeshFile& mesh = *bone;
+  CapDepartureInput in;
+  in.vertices = mesh.vertices;
+  in.triangles = mesh.triangles;
+  in.model = model;
+  in.points = points::readPoints(folder / "points.ply").positions;
+  if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
+  in.ct = ct;
+  // LPS: +x is the patient's left, so a right hip's medial side is +x.
+  if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
+  return capDepartures(in);
+}
+
+// The bone's triangles whose corners all lie in one departing region (a
+// fovea aside), for the 3-D view.
+report::ViewSurface departingSurface(const points::MeshFile& bone, const CapDepartures& departures) {
+  const auto region = [&departures](int v) { return departures.region_of_vertex[static_cast<size_t>(v)]; };
+  return meshPart(bone, "departing from the model", [&](Eigen::Index f) {
+    const int r = region(bone.triangles(f, 0));
+    return r >= 0 && region(bone.triangles(f, 1)) == r && region(bone.triangles(f, 2)) == r &&
+           departures.regions[static_cast<size_t>(r)].kind != "fovea";
+  });
 }
 
 }  // namespace
@@ -301,9 +346,6 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
   for (int i = 0; i < 3; ++i)
     axes.push_back({axis_names[i], c - semiAxes(best_shape)[i] * R.col(i), c + semiAxes(best_shape)[i] * R.col(i)});
-  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
-  SlicerSceneContent scene;
-  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
 
   json steps_json = json::array(), path_json = json::array();
   for (const NestedStep& st : selection.steps) steps_json.push_back(stepJson(st));
@@ -311,7 +353,26 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
 
   std::string no_ct;
   const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
-  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get());
+  geometry::ShapeParameters selected_shape = best_shape;
+  for (const auto& shape : shapes)
+    if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
+  std::optional<points::MeshFile> bone;
+  if (fs::exists(o.folder / "bone.vtp")) bone = points::readMeshFile(o.folder / "bone.vtp");
+  const std::optional<CapDepartures> departures =
+      departuresFromModel(o.folder, bone, selected_shape, ct.get(), o.joint, o.side);
+  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get(), departures);
+  // The head centre, and where the bone departs from the selected model.
+  std::vector<Landmark> landmarks = {{"head_center", c}};
+  if (departures)
+    for (size_t k = 0; k < departures->regions.size(); ++k) {
+      const DepartingRegion& region = departures->regions[k];
+      landmarks.push_back({"departure_" + std::to_string(k + 1) + " (" + region.kind + ", " + number(std::round(region.area_mm2)) +
+                               " mm2, " + number(std::round(10 * region.depth_mm) / 10) + " mm)",
+                           region.centre});
+    }
+  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", landmarks, axes);
+  SlicerSceneContent scene;
+  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", landmarks, axes);
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
@@ -340,6 +401,7 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
         {"undetermined", selection.undetermined}}},
       {"head_center_mm", {c[0], c[1], c[2]}},
       {"qc", qc.toJson()},
+      {"cap_departures", departures ? departures->toJson() : json(nullptr)},
       {"models", models},
       {"coordinate_system", "LPS"},
       {"units", "mm"},
@@ -354,8 +416,13 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     if (fs::exists(o.folder / "errors" / ("points_" + geometry::modelName(shape.model) + ".vtp")))
       scene.models.push_back(geometry::modelName(shape.model));
   try {
-    const report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
-    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = report::symmetricColourRange(d.signed_distance_mm);
+    report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
+    if (bone && departures) view.departures = departingSurface(*bone, *departures);
+    // One colour, one distance: the error maps' scale on the view and in Slicer.
+    std::vector<report::ErrorMapPanel> panels;
+    for (const auto& d : view.distances) panels.push_back({d.model, d.signed_distance_mm});
+    if (!panels.empty()) view.colour_range_mm = report::sharedColourLimit(panels);
+    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = view.colour_range_mm;
     view_html = report::web3dViewHtml(view);
   } catch (const Error& e) {
     view_html = "<section id=\"view3d\"><h2>3-D view</h2><p class=\"note\">No 3-D view: " + report::escapeMarkup(e.what()) +
