@@ -17,6 +17,7 @@ import json
 import math
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 import time
@@ -29,7 +30,7 @@ CASES = {
     "articula-normal": ("articula", ["--seed", "11", "--radius", "23", "--gap", "2"]),
     "articula-osteoporotic": ("articula", ["--seed", "12", "--radius", "21", "--gap", "2", "--osteoporotic"]),
     "independent-normal": ("independent", ["side=right", "R=23", "gap=2", "seed=1"]),
-    "independent-thin": ("independent", ["side=right", "R=25", "gap=1.5", "cortex=0.8", "cort_hu=800", "trab_hu=200",
+    "independent-thin": ("independent", ["side=right", "R=25", "gap=2.5", "cortex=0.8", "cort_hu=800", "trab_hu=200",
                                          "seed=5"]),
     "third-normal": ("third", ["joint=hip", "side=right", "seed=101", "R=23", "gap=2.5", "cover=105", "excess=1.5"]),
     "third-thin": ("third", ["joint=hip", "side=left", "seed=109", "R=21", "gap=2", "cortex=0.8", "cort_hu=700",
@@ -45,15 +46,20 @@ def side_of(gen, opts):
 
 
 def make_phantom(gen, opts, spacing, folder):
-    """Writes the CT (returns its path and the truth's path) unless cached."""
+    """Writes the CT (returns its path and the truth's path) unless cached
+    with the same options."""
     sp = ",".join(f"{v:g}" for v in spacing)
+    stamp, said = f"{folder}/options.txt", " ".join([gen, sp, *opts])
+    if os.path.exists(stamp) and open(stamp).read() != said:
+        shutil.rmtree(folder)
+    os.makedirs(folder, exist_ok=True)
+    open(stamp, "w").write(said)
     if gen == "articula":
         ct, truth = f"{folder}/phantom.nii.gz", f"{folder}/truth.json"
         if not os.path.exists(truth):
             subprocess.run([f"{ARGS.bin}/articula", "phantom", "-o", folder, "--exact", "--no-dicom", "--force", "-q",
                             "--spacing", sp, *opts], check=True, stdout=subprocess.DEVNULL)
         return ct, truth
-    os.makedirs(folder, exist_ok=True)
     base = f"{folder}/ct"
     if not os.path.exists(base + ".json"):
         script = "independent_phantom.py" if gen == "independent" else "third_phantom.py"

@@ -2,6 +2,10 @@
 
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
 #include <vtkFlyingEdges3D.h>
@@ -295,8 +299,7 @@ int passesToReach(double edge_mm, double reach_mm) {
 /// centimetres; each spread of a line's voxels about their true depths
 /// reads as blur), within +-1/5 mm.
 std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
-                                  double edge_mm) {
-  constexpr double kReachMm = 2.0;
+                                  double edge_mm, double reach_mm) {
   const size_t n = neighbours.size();
   std::vector<double> curvature(n, 0.0);
   for (size_t i = 0; i < n; ++i) {
@@ -308,7 +311,7 @@ std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<st
     }
     if (!neighbours[i].empty()) curvature[i] = sum / static_cast<double>(neighbours[i].size());
   }
-  for (int pass = passesToReach(edge_mm, kReachMm); pass > 0; --pass) {
+  for (int pass = passesToReach(edge_mm, reach_mm); pass > 0; --pass) {
     std::vector<double> next(n, 0.0);
     for (size_t i = 0; i < n; ++i) {
       double sum = curvature[i];
@@ -326,10 +329,9 @@ std::vector<double> meanCurvature(const TriangleMesh& mesh, const std::vector<st
 /// rms (0.7 mm voxels), and each degree of tilt spreads a line's voxels
 /// about their depths like blur.
 Eigen::MatrixX3d smoothedNormals(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
-                                 double edge_mm) {
-  constexpr double kReachMm = 1.0;
+                                 double edge_mm, double reach_mm) {
   Eigen::MatrixX3d normals = mesh.normals;
-  for (int pass = passesToReach(edge_mm, kReachMm); pass > 0; --pass) {
+  for (int pass = passesToReach(edge_mm, reach_mm); pass > 0; --pass) {
     Eigen::MatrixX3d next = normals;
     for (size_t i = 0; i < neighbours.size(); ++i) {
       Eigen::RowVector3d sum = normals.row(static_cast<Eigen::Index>(i));
@@ -339,6 +341,56 @@ Eigen::MatrixX3d smoothedNormals(const TriangleMesh& mesh, const std::vector<std
     normals.swap(next);
   }
   return normals;
+}
+
+/// Each vertex's cortex from the `known` ones' (the fits of the lines
+/// within the slices): spread ring by ring over the mesh to the others
+/// (each the mean of its reached neighbours), then averaged over about
+/// 3 mm (a single line's thickness and levels are noisy). `known` then
+/// marks every vertex reached.
+void tissueOverMesh(const std::vector<std::vector<int>>& neighbours, double edge_mm,
+                    std::vector<imaging::CortexTissue>& tissue, std::vector<char>& known) {
+  constexpr double kReachMm = 3.0;
+  const auto add = [](imaging::CortexTissue& sum, const imaging::CortexTissue& t) {
+    sum.thickness_mm += t.thickness_mm;
+    sum.outside_hu += t.outside_hu;
+    sum.cortex_hu += t.cortex_hu;
+    sum.inside_hu += t.inside_hu;
+  };
+  const auto divide = [](imaging::CortexTissue t, double n) {
+    t.thickness_mm /= n, t.outside_hu /= n, t.cortex_hu /= n, t.inside_hu /= n;
+    return t;
+  };
+  for (bool spreading = true; spreading;) {
+    spreading = false;
+    std::vector<char> next_known = known;
+    std::vector<imaging::CortexTissue> next = tissue;
+    for (size_t v = 0; v < tissue.size(); ++v) {
+      if (known[v]) continue;
+      imaging::CortexTissue sum;
+      int count = 0;
+      for (const int w : neighbours[v])
+        if (known[static_cast<size_t>(w)]) add(sum, tissue[static_cast<size_t>(w)]), ++count;
+      if (count == 0) continue;
+      next[v] = divide(sum, count);
+      next_known[v] = 1;
+      spreading = true;
+    }
+    tissue.swap(next);
+    known.swap(next_known);
+  }
+  for (int pass = passesToReach(edge_mm, kReachMm); pass > 0; --pass) {
+    std::vector<imaging::CortexTissue> next = tissue;
+    for (size_t v = 0; v < tissue.size(); ++v) {
+      if (!known[v]) continue;
+      imaging::CortexTissue sum = tissue[v];
+      int count = 1;
+      for (const int w : neighbours[v])
+        if (known[static_cast<size_t>(w)]) add(sum, tissue[static_cast<size_t>(w)]), ++count;
+      next[v] = divide(sum, count);
+    }
+    tissue.swap(next);
+  }
 }
 
 /// Moves the found steepest falls (`shift` along the normals) onto the
@@ -351,7 +403,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
                         const imaging::Volume& ct, const std::vector<char>& found, std::vector<double>& shift,
                         const EdgeSnapOptions& options, EdgeSnapSummary& s) {
   constexpr size_t kPointSpreadLines = 600;
-  const double radius = imaging::lineRadiusFor(ct.geometry);
+  constexpr double kTypicalCortexRatio = 1.5;  // a line within the slices tells the cortex when within this factor of the median
   // The lines run along the normals of the surface moved onto the steepest
   // falls (their shifts averaged as the final surface's are), averaged over
   // about a millimetre: the label's smoothed voxel surface tilts them by
@@ -367,23 +419,53 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   }
   on_falls.normals = fromVtk(withNormals(toVtk(on_falls))).normals;
   const double edge_mm = meanEdgeLength(on_falls, neighbours);
-  on_falls.normals = smoothedNormals(on_falls, neighbours, edge_mm);
-  const std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm);
-  const auto lineAt = [&](Eigen::Index v) {
+  const double slices_mm = imaging::tissueHeldAcrossSlices(ct.geometry.spacing) && !std::getenv("ARTICULA_DEBUG_NOREACH") ? ct.geometry.spacing[2] : 0.0;
+  on_falls.normals = smoothedNormals(on_falls, neighbours, edge_mm, std::max(1.0, slices_mm));
+  std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm, std::max(2.0, 2 * slices_mm));
+  if (const char* c = std::getenv("ARTICULA_DEBUG_SPHERE")) {  // DEBUG: cx,cy,cz,R
+    double cx, cy, cz, R;
+    std::sscanf(c, "%lf,%lf,%lf,%lf", &cx, &cy, &cz, &R);
+    const Eigen::RowVector3d centre(cx, cy, cz);
+    for (Eigen::Index v = 0; v < on_falls.vertices.rows(); ++v) {
+      const Eigen::RowVector3d d = on_falls.vertices.row(v) - centre;
+      if (std::getenv("ARTICULA_DEBUG_ONSURFACE")) on_falls.vertices.row(v) = centre + R * d.normalized();
+      on_falls.normals.row(v) = d.normalized();
+      curvature[static_cast<size_t>(v)] = 1.0 / R;
+    }
+  }
+  // `covering`: with the radius that lets a line across long slices see its
+  // surface at every depth (the fits); without, the common radius (the
+  // point-spread's estimate, which the wider lines' geometry would widen).
+  const auto lineAt = [&](Eigen::Index v, bool covering) {
     const Eigen::Vector3d n = on_falls.normals.row(v).transpose();
-    return imaging::voxelsAboutLine(ct, on_falls.vertices.row(v).transpose(), n, -imaging::kCortexInwardMm,
-                                    imaging::kCortexOutwardMm, radius, curvature[static_cast<size_t>(v)]);
+    const Eigen::Vector3d axis_step = ct.geometry.spacing.cwiseProduct(ct.geometry.direction.transpose() * n);
+    const double further_in = imaging::cortexSearchMm(axis_step) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
+    return imaging::voxelsAboutLine(ct, on_falls.vertices.row(v).transpose(), n, -imaging::kCortexInwardMm - further_in,
+                                    imaging::kCortexOutwardMm,
+                                    covering ? imaging::lineRadiusFor(ct.geometry, n) : imaging::lineRadiusFor(ct.geometry),
+                                    curvature[static_cast<size_t>(v)]);
   };
   std::vector<Eigen::Index> on_edge;
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
     if (found[static_cast<size_t>(v)]) on_edge.push_back(v);
+  // With slices much longer than the in-plane voxels, the lines within the
+  // slices tell the cortex's thickness and levels, and the lines across
+  // them are fitted with those of their neighbourhood (imaging::fitCortex).
+  const bool held_across = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
+  const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
+  std::vector<char> within(static_cast<size_t>(mesh.vertices.rows()), 1);
+  if (held_across)
+    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+      const double across = on_falls.normals.row(v).dot(slice_axis.transpose());
+      within[static_cast<size_t>(v)] = across * across < imaging::kWithinSlicesShare;
+    }
   imaging::PointSpread spread;
   spread.sigma_mm = options.point_spread_mm;
   spread.slice_sigma_mm = options.slice_point_spread_mm > 0 ? options.slice_point_spread_mm : options.point_spread_mm;
   if (options.point_spread_mm <= 0) {
     std::vector<imaging::LineVoxels> lines;
     const size_t stride = std::max<size_t>(1, on_edge.size() / kPointSpreadLines);
-    for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i]));
+    for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i], false));
     spread = imaging::estimatePointSpread(lines);
     if (!spread.found) {
       s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(spread.profiles) +
@@ -396,20 +478,65 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   s.slice_point_spread_mm = spread.slice_sigma_mm;
   s.point_spread_on_voxel_grid = spread.kind == imaging::PointSpread::Kind::VoxelGrid;
   std::vector<imaging::CortexFit> fits(on_edge.size());
-  parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
-    for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
-      const imaging::LineVoxels line = lineAt(on_edge[i]);
-      fits[i] = imaging::fitCortex(line, 0.0, imaging::StepResponse(line, spread), options.min_contrast_hu);
+  const auto fitLines = [&](bool which, const std::vector<imaging::CortexTissue>* held) {
+    parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+      for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
+        const auto v = static_cast<size_t>(on_edge[i]);
+        if (static_cast<bool>(within[v]) != which) continue;
+        const imaging::LineVoxels line = lineAt(on_edge[i], true);
+        fits[i] = imaging::fitCortex(line, 0.0, imaging::StepResponse(line, spread), options.min_contrast_hu,
+                                     held ? &(*held)[v] : nullptr);
+      }
+    });
+  };
+  fitLines(true, nullptr);
+  if (held_across) {
+    // Only lines whose cortex is like most lines' within the slices tell
+    // it: about a pole at 3 mm slices the surface on the steepest falls
+    // climbs in terraces, and a riser's line, level with the slices, meets
+    // the bone aslant (its cortex came out 2.1 mm thick for 0.8).
+    std::vector<double> thickness;
+    for (size_t i = 0; i < on_edge.size(); ++i)
+      if (fits[i].found && within[static_cast<size_t>(on_edge[i])]) thickness.push_back(fits[i].thickness_mm);
+    std::nth_element(thickness.begin(), thickness.begin() + static_cast<long>(thickness.size() / 2), thickness.end());
+    const double typical = thickness.empty() ? 0.0 : thickness[thickness.size() / 2];
+    std::vector<imaging::CortexTissue> tissue(static_cast<size_t>(mesh.vertices.rows()));
+    std::vector<char> known(tissue.size(), 0);
+    for (size_t i = 0; i < on_edge.size(); ++i)
+      if (fits[i].found && std::abs(std::log(fits[i].thickness_mm / typical)) < std::log(kTypicalCortexRatio)) {
+        tissue[static_cast<size_t>(on_edge[i])] = fits[i];
+        known[static_cast<size_t>(on_edge[i])] = 1;
+      }
+    tissueOverMesh(neighbours, edge_mm, tissue, known);
+    fitLines(false, &tissue);
+    for (size_t i = 0; i < on_edge.size(); ++i)
+      if (!known[static_cast<size_t>(on_edge[i])]) fits[i].found = false;  // no tissue reached it
+  }
+  if (const char* dump = std::getenv("ARTICULA_DEBUG_CORTEX")) {  // DEBUG
+    std::ofstream out(dump);
+    out << "x_mm,y_mm,z_mm,nx,ny,nz,slice_share,offset,thickness,outside,cortex,inside,found,voxels,ss,curv\n";
+    for (size_t i = 0; i < on_edge.size(); ++i) {
+      const Eigen::Index v = on_edge[i];
+      const imaging::LineVoxels line = lineAt(v, true);
+      out << on_falls.vertices(v, 0) << ',' << on_falls.vertices(v, 1) << ',' << on_falls.vertices(v, 2) << ','
+          << on_falls.normals(v, 0) << ',' << on_falls.normals(v, 1) << ',' << on_falls.normals(v, 2) << ','
+          << line.slice_share << ',' << fits[i].offset_mm << ',' << fits[i].thickness_mm << ',' << fits[i].outside_hu
+          << ',' << fits[i].cortex_hu << ',' << fits[i].inside_hu << ',' << fits[i].found << ','
+          << line.offset_mm.size() << ',' << fits[i].sum_squares << ',' << curvature[static_cast<size_t>(v)] << '\n';
     }
-  });
+  }
   double moved = 0;
   for (size_t i = 0; i < on_edge.size(); ++i) {
     if (!fits[i].found) continue;
-    // From the averaged fall, along the moved surface's normal (within a few
-    // degrees of the label's, along which the vertex moves: a cosine's worth).
+    // From the averaged fall the model's surface lies offset_mm along the
+    // line; the vertex moves along the label's normal, so it goes to where
+    // that normal meets the model's tangent plane (the two normals part by
+    // a few degrees at fine voxels, by up to 30 about a pole's terrace at
+    // 3 mm slices).
     const auto v = static_cast<size_t>(on_edge[i]);
-    const double from_fall = averaged[v] + fits[i].offset_mm - shift[v];
-    shift[v] = averaged[v] + fits[i].offset_mm;
+    const double cosine = std::max(0.5, mesh.normals.row(on_edge[i]).dot(on_falls.normals.row(on_edge[i])));
+    const double from_fall = averaged[v] + fits[i].offset_mm / cosine - shift[v];
+    shift[v] = averaged[v] + fits[i].offset_mm / cosine;
     moved += from_fall;
     ++s.on_cortex_model;
   }
@@ -438,9 +565,20 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   EdgeSnapSummary s;
   s.vertices = n;
   const bool look_further = ct.geometry.spacing.maxCoeff() <= imaging::kSeparateEdgesMaxVoxelMm + 1e-6;
+  // Across long slices a line's trilinear profile is straight between them:
+  // its steepest fall keeps to the middle between two slices (a flat
+  // terrace about a head's pole at 3 mm slices) unless the profile is
+  // smoothed over about a third of the voxel's extent along the line.
+  const bool long_slices = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
   for (Eigen::Index v = 0; v < n; ++v) {
+    imaging::EdgeSearch along = search;
+    if (long_slices && options.search_mm <= 0 && !std::getenv("ARTICULA_DEBUG_NOSMOOTH")) {
+      const Eigen::Vector3d u = mesh.normals.row(v).transpose();
+      const double extent = ct.geometry.spacing.cwiseProduct(ct.geometry.direction.transpose() * u).norm();
+      along.smoothing_mm = std::max(std::max(0.15, 0.25 * ct.geometry.spacing.minCoeff()), 0.3 * extent);
+    }
     const imaging::Edge e =
-        boneEdge(ct, mesh.vertices.row(v).transpose(), mesh.normals.row(v).transpose(), search, look_further);
+        boneEdge(ct, mesh.vertices.row(v).transpose(), mesh.normals.row(v).transpose(), along, look_further);
     if (!e.found) continue;
     shift[static_cast<size_t>(v)] = e.offset_mm;
     found[static_cast<size_t>(v)] = 1;
