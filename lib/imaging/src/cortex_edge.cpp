@@ -593,11 +593,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
     ps.found = true;
     return ps;
   }
-  if (tissueHeldAcrossSlices(lines.front().spacing_mm)) {
-    ps.found = true;
-    ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
-    return ps;
-  }
+
   // The slice width, then the width within the slices, each searched over
   // [common / 2.5, common * 2.5] and refined; kept only when the two fit
   // better than the one by more than the log of the voxels' count (the
@@ -621,6 +617,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
   for (const LineVoxels& line : lines) voxels += static_cast<double>(line.offset_mm.size());
   if (chosen_value - split_value > std::log(voxels)) ps = split;
   ps.found = true;
+  if (tissueHeldAcrossSlices(lines.front().spacing_mm)) ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
   return ps;
 }
 
