@@ -41,7 +41,7 @@ class MeshCommand : public cli::Command {
                    "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
                    "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
                    "the voxels about the normal, with one point-spread for the CT; 'auto' the cortex model on CTs "
-                   "whose voxels are at most 0.8 mm on every side, the steepest fall beyond")
+                   "whose voxels are at most 1 mm within the slices and 3 mm across them, the steepest fall beyond")
         ->check(CLI::IsMember({"auto", "cortex", "steepest"}))
         ->capture_default_str();
     app.add_option("--point-spread", snap_.point_spread_mm,

@@ -4,8 +4,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <nlopt.hpp>
@@ -22,8 +20,8 @@ constexpr int kMinLines = 30;
 constexpr double kMinAcrossShare = 0.1;  // of the lines' summed slice share, for a slice width of its own
 constexpr double kWidthRange = 2.5;      // each width within this factor of the common one
 constexpr double kSocketRiseHu = 150;  // a rise beyond the edge this high is a socket (the edges' least contrast)
-constexpr double kHeldLevelVoxels = 4;
-constexpr double kHeldAcrossSlicesRatio = 1.2;  // slices this much longer than the in-plane voxel  // a held level weighs as much as this many voxels that show it
+constexpr double kHeldLevelVoxels = 4;          // a held level weighs as much as this many voxels that show it
+constexpr double kHeldAcrossSlicesRatio = 1.2;  // slices this much longer than the in-plane voxel
 
 constexpr double kTableStepMm = 0.01;    // a voxel-grid blur's step response is tabulated this finely
 constexpr double kGridKernelWidths = 4;  // image filters' usual truncation of a sampled Gaussian
@@ -38,15 +36,24 @@ std::vector<double> spreadOver(const std::vector<double>& density, double& first
   for (const auto& [offset, weight] : offsets_weights) low = std::min(low, offset), high = std::max(high, offset);
   const auto pad_low = static_cast<int>(std::ceil(-low / kTableStepMm)) + 1;
   const auto pad_high = static_cast<int>(std::ceil(high / kTableStepMm)) + 1;
+  // Each weight lands a whole number of steps away plus the same share of
+  // one for every point of the density.
+  struct Landing {
+    size_t steps;
+    double below, above;
+  };
+  std::vector<Landing> landings;
+  for (const auto& [offset, weight] : offsets_weights) {
+    const double at = pad_low + offset / kTableStepMm, whole = std::floor(at);
+    landings.push_back({static_cast<size_t>(whole), weight * (1 - (at - whole)), weight * (at - whole)});
+  }
   std::vector<double> out(density.size() + static_cast<size_t>(pad_low + pad_high), 0.0);
   for (size_t i = 0; i < density.size(); ++i) {
-    if (density[i] == 0) continue;
-    for (const auto& [offset, weight] : offsets_weights) {
-      const double at = static_cast<double>(i + static_cast<size_t>(pad_low)) + offset / kTableStepMm;
-      const auto below = static_cast<size_t>(std::floor(at));
-      const double above_share = at - std::floor(at);
-      out[below] += density[i] * weight * (1 - above_share);
-      out[below + 1] += density[i] * weight * above_share;
+    const double d = density[i];
+    if (d == 0) continue;
+    for (const Landing& l : landings) {
+      out[i + l.steps] += d * l.below;
+      out[i + l.steps + 1] += d * l.above;
     }
   }
   first_mm -= pad_low * kTableStepMm;
@@ -82,24 +89,16 @@ struct Levels {
   double sum_squares = 0;
 };
 
-/// Least squares over the columns in `use` (the others held at zero), each
-/// level i < 3 drawn towards prior[i] with weight `prior_weight` (as if that
-/// many voxels had shown it alone); the residual includes that pull.
+/// Least squares of the voxels' values over the columns of `rows` in `use`
+/// (the others held at zero), each level i < 3 drawn towards prior[i] with
+/// weight `prior_weight` (as if that many voxels had shown it alone); the
+/// residual includes that pull. `normal` and `rhs`: the rows' sums
+/// (rows^T rows, rows^T values), made once for both of fitLevels' solves.
 Levels solveLevels(const std::vector<Eigen::Vector4d>& rows, const std::vector<double>& values,
-                   const Eigen::Vector4d& use, const Eigen::Vector4d& prior = Eigen::Vector4d::Zero(),
-                   double prior_weight = 0) {
-  // The normal equations' ten distinct sums by hand: Eigen's rank update of
-  // a 4 x 4 matrix took a sixth of the model's time.
-  double n00 = 0, n10 = 0, n11 = 0, n20 = 0, n21 = 0, n22 = 0, n30 = 0, n31 = 0, n32 = 0, n33 = 0;
-  Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const Eigen::Vector4d r = rows[i].cwiseProduct(use);
-    n00 += r[0] * r[0], n10 += r[1] * r[0], n11 += r[1] * r[1], n20 += r[2] * r[0], n21 += r[2] * r[1];
-    n22 += r[2] * r[2], n30 += r[3] * r[0], n31 += r[3] * r[1], n32 += r[3] * r[2], n33 += r[3] * r[3];
-    rhs += r * values[i];
-  }
-  Eigen::Matrix4d normal;
-  normal << n00, n10, n20, n30, n10, n11, n21, n31, n20, n21, n22, n32, n30, n31, n32, n33;
+                   const Eigen::Matrix4d& sums, const Eigen::Vector4d& rhs_sums, const Eigen::Vector4d& use,
+                   const Eigen::Vector4d& prior, double prior_weight) {
+  Eigen::Matrix4d normal = sums.cwiseProduct(use * use.transpose());
+  Eigen::Vector4d rhs = rhs_sums.cwiseProduct(use);
   // A tiny ridge: a level the window does not reach (a cortex thicker than
   // it) stays at the outside's instead of making the system singular.
   normal.diagonal().array() += 1e-6 * static_cast<double>(rows.size());
@@ -122,22 +121,33 @@ Levels solveLevels(const std::vector<Eigen::Vector4d>& rows, const std::vector<d
 /// f = outside + a (cortex layer) + b (cancellous) + c (socket), the levels
 /// relative to the outside. The socket is brighter than the gap or absent:
 /// a darker step there would reshape the surface's own fall and trade
-/// against the blur.
-/// With `held` tissue, its levels are drawn towards the held ones.
+/// against the blur. With `held` tissue, its levels are drawn towards the
+/// held ones.
 Levels fitLevels(const LineVoxels& line, double e, double t, double g, const StepResponse& blur,
                  const CortexTissue* held = nullptr) {
   const size_t n = line.offset_mm.size();
-  std::vector<Eigen::Vector4d> rows(n);
+  thread_local std::vector<Eigen::Vector4d> rows;  // reused: this runs some 10^7 times in a CT's estimate
+  rows.resize(n);
+  // The normal equations' ten distinct sums by hand: Eigen's rank update of
+  // a 4 x 4 matrix took a sixth of the model's time.
+  double n00 = 0, n10 = 0, n11 = 0, n20 = 0, n21 = 0, n22 = 0, n30 = 0, n31 = 0, n32 = 0, n33 = 0;
+  Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
   for (size_t i = 0; i < n; ++i) {
     const double s = line.offset_mm[i];
     const double k0 = blur.brightShare(e - s), k1 = blur.brightShare(e - t - s), k2 = blur.brightShare(s - e - g);
-    rows[i] = Eigen::Vector4d(1.0, k0 - k1, k1, k2);
+    const Eigen::Vector4d r(1.0, k0 - k1, k1, k2);
+    rows[i] = r;
+    n00 += 1, n10 += r[1], n11 += r[1] * r[1], n20 += r[2], n21 += r[2] * r[1];
+    n22 += r[2] * r[2], n30 += r[3], n31 += r[3] * r[1], n32 += r[3] * r[2], n33 += r[3] * r[3];
+    rhs += r * line.value_hu[i];
   }
+  Eigen::Matrix4d sums;
+  sums << n00, n10, n20, n30, n10, n11, n21, n31, n20, n21, n22, n32, n30, n31, n32, n33;
   Eigen::Vector4d prior = Eigen::Vector4d::Zero();
   if (held) prior << held->outside_hu, held->cortex_hu - held->outside_hu, held->inside_hu - held->outside_hu, 0;
   const double weight = held ? kHeldLevelVoxels : 0.0;
-  Levels l = solveLevels(rows, line.value_hu, Eigen::Vector4d::Ones(), prior, weight);
-  if (l.coef[3] < 0) l = solveLevels(rows, line.value_hu, Eigen::Vector4d(1, 1, 1, 0), prior, weight);
+  Levels l = solveLevels(rows, line.value_hu, sums, rhs, Eigen::Vector4d::Ones(), prior, weight);
+  if (l.coef[3] < 0) l = solveLevels(rows, line.value_hu, sums, rhs, Eigen::Vector4d(1, 1, 1, 0), prior, weight);
   return l;
 }
 
@@ -421,6 +431,7 @@ CortexFit fitCortex(const LineVoxels& whole_line, double guess_mm, const StepRes
   const Levels l = fitLevels(line, p[0], p[1], p[2], blur, held);
   fit.offset_mm = p[0];
   fit.thickness_mm = p[1];
+  fit.gap_mm = p[2];
   fit.outside_hu = l.coef[0];
   fit.cortex_hu = l.coef[0] + l.coef[1];
   fit.inside_hu = l.coef[0] + l.coef[2];
@@ -478,8 +489,12 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
   // Summed over the same lines at every width; a line found at no width adds
   // its fit anyway (its residual still tells how well that width explains it).
   // Each line's noise is its own (its misfit too): n log(residual) per line.
-  const auto profileLogLikelihood = [](const LineVoxels& line, const PointSpread& spread, const CortexTissue* held) {
+  // (Each search starts afresh: started from the line's fit at the nearest
+  // width tried, the searches ended where they came from, and the estimate
+  // followed them, 0.75 mm for a flat thick cortex's 0.7.)
+  const auto profileLogLikelihood = [&](size_t index, const PointSpread& spread, const CortexTissue* held) {
     constexpr double kLeastSumSquares = 1e-9;  // a noiseless line
+    const LineVoxels& line = lines[index];
     return static_cast<double>(line.offset_mm.size()) *
            std::log(std::max(fitCortex(line, 0.0, StepResponse(line, spread), 0.0, held).sum_squares, kLeastSumSquares));
   };
@@ -493,7 +508,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
     std::vector<double> each(subset.size());
     parallelFor(static_cast<std::ptrdiff_t>(subset.size()), 8, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
-        each[i] = profileLogLikelihood(lines[subset[i]], trial, held ? &(*held)[i] : nullptr);
+        each[i] = profileLogLikelihood(subset[i], trial, held ? &(*held)[i] : nullptr);
     });
     double sum = 0;
     for (const double e : each) sum += e;  // in order: the same sum for any thread count
@@ -514,11 +529,6 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
     }
     const auto at = std::min_element(negated_log_likelihood.begin(), negated_log_likelihood.end()) -
                     negated_log_likelihood.begin();
-    if (std::getenv("ARTICULA_DEBUG_WIDTH")) {  // DEBUG
-      fprintf(stderr, "kind %d lines %zu:", static_cast<int>(kind), subset.size());
-      for (size_t i = 0; i < grid_mm.size(); ++i) fprintf(stderr, " %.2f:%.0f", grid_mm[i], negated_log_likelihood[i] - negated_log_likelihood[static_cast<size_t>(at)]);
-      fprintf(stderr, "\n");
-    }
     Common c;
     if (at == 0 || at + 1 == static_cast<long>(grid_mm.size())) return c;
     const auto [width, value] = leastOfSmoothed(f, grid_mm[static_cast<size_t>(at)] - kStep,
@@ -574,8 +584,10 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
     if (known.size() < static_cast<size_t>(kMinLines)) return spread.slice_sigma_mm;
     for (const size_t i : out) points.push_back(lines[i].point_mm);
     const std::vector<CortexTissue> held = nearbyTissue(points, known_points, known);
+    // With the tissue held, a width 0.05 mm off moves the surface little:
+    // a coarse grid and one parabola about its best.
     const auto f = [&](double s) { return total(out, spread.kind, spread.sigma_mm, s, &held); };
-    constexpr double kStep = 0.15, kFirst = 0.05, kLast = 3.0;
+    constexpr double kStep = 0.2, kFirst = 0.05, kLast = 2.85;
     std::vector<double> grid_mm, negated_log_likelihood;
     for (double s = kFirst; s <= kLast + 1e-9; s += kStep) {
       grid_mm.push_back(s);
@@ -584,8 +596,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
     const auto at = static_cast<size_t>(std::min_element(negated_log_likelihood.begin(), negated_log_likelihood.end()) -
                                         negated_log_likelihood.begin());
     if (at + 1 == grid_mm.size()) return spread.slice_sigma_mm;  // wider than any CT's slices blur
-    const double coarse = leastOfSmoothed(f, grid_mm[at] - kStep, grid_mm[at] + kStep, 0.03).first;
-    return std::max(0.01, leastOfSmoothed(f, coarse - 0.05, coarse + 0.05, 0.01).first);
+    return std::max(0.01, leastOfSmoothed(f, grid_mm[at] - kStep, grid_mm[at] + kStep, 0.04).first);
   };
   // The slice width needs lines across the slices: where fewer than a tenth
   // of the lines' spread runs across them, it stays at the common one.

@@ -2,10 +2,6 @@
 
 #include <unistd.h>
 
-#include <cstdio>
-#include <cstdlib>
-#include <fstream>
-
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
 #include <vtkFlyingEdges3D.h>
@@ -419,20 +415,10 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   }
   on_falls.normals = fromVtk(withNormals(toVtk(on_falls))).normals;
   const double edge_mm = meanEdgeLength(on_falls, neighbours);
-  const double slices_mm = imaging::tissueHeldAcrossSlices(ct.geometry.spacing) && !std::getenv("ARTICULA_DEBUG_NOREACH") ? ct.geometry.spacing[2] : 0.0;
+  const double slices_mm = imaging::tissueHeldAcrossSlices(ct.geometry.spacing) ? ct.geometry.spacing[2] : 0.0;
   on_falls.normals = smoothedNormals(on_falls, neighbours, edge_mm, std::max(1.0, slices_mm));
-  std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm, std::max(2.0, 2 * slices_mm));
-  if (const char* c = std::getenv("ARTICULA_DEBUG_SPHERE")) {  // DEBUG: cx,cy,cz,R
-    double cx, cy, cz, R;
-    std::sscanf(c, "%lf,%lf,%lf,%lf", &cx, &cy, &cz, &R);
-    const Eigen::RowVector3d centre(cx, cy, cz);
-    for (Eigen::Index v = 0; v < on_falls.vertices.rows(); ++v) {
-      const Eigen::RowVector3d d = on_falls.vertices.row(v) - centre;
-      if (std::getenv("ARTICULA_DEBUG_ONSURFACE")) on_falls.vertices.row(v) = centre + R * d.normalized();
-      on_falls.normals.row(v) = d.normalized();
-      curvature[static_cast<size_t>(v)] = 1.0 / R;
-    }
-  }
+  const std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm, std::max(2.0, 2 * slices_mm));
+
   // `covering`: with the radius that lets a line across long slices see its
   // surface at every depth (the fits); without, the common radius (the
   // point-spread's estimate, which the wider lines' geometry would widen).
@@ -512,19 +498,6 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     for (size_t i = 0; i < on_edge.size(); ++i)
       if (!known[static_cast<size_t>(on_edge[i])]) fits[i].found = false;  // no tissue reached it
   }
-  if (const char* dump = std::getenv("ARTICULA_DEBUG_CORTEX")) {  // DEBUG
-    std::ofstream out(dump);
-    out << "x_mm,y_mm,z_mm,nx,ny,nz,slice_share,offset,thickness,outside,cortex,inside,found,voxels,ss,curv\n";
-    for (size_t i = 0; i < on_edge.size(); ++i) {
-      const Eigen::Index v = on_edge[i];
-      const imaging::LineVoxels line = lineAt(v, true);
-      out << on_falls.vertices(v, 0) << ',' << on_falls.vertices(v, 1) << ',' << on_falls.vertices(v, 2) << ','
-          << on_falls.normals(v, 0) << ',' << on_falls.normals(v, 1) << ',' << on_falls.normals(v, 2) << ','
-          << line.slice_share << ',' << fits[i].offset_mm << ',' << fits[i].thickness_mm << ',' << fits[i].outside_hu
-          << ',' << fits[i].cortex_hu << ',' << fits[i].inside_hu << ',' << fits[i].found << ','
-          << line.offset_mm.size() << ',' << fits[i].sum_squares << ',' << curvature[static_cast<size_t>(v)] << '\n';
-    }
-  }
   double moved = 0;
   for (size_t i = 0; i < on_edge.size(); ++i) {
     if (!fits[i].found) continue;
@@ -572,7 +545,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   const bool long_slices = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
   for (Eigen::Index v = 0; v < n; ++v) {
     imaging::EdgeSearch along = search;
-    if (long_slices && options.search_mm <= 0 && !std::getenv("ARTICULA_DEBUG_NOSMOOTH")) {
+    if (long_slices && options.search_mm <= 0) {
       const Eigen::Vector3d u = mesh.normals.row(v).transpose();
       const double extent = ct.geometry.spacing.cwiseProduct(ct.geometry.direction.transpose() * u).norm();
       along.smoothing_mm = std::max(std::max(0.15, 0.25 * ct.geometry.spacing.minCoeff()), 0.3 * extent);
@@ -599,7 +572,9 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     }
   const bool cortex_model =
       options.edge_model == EdgeModel::Cortex ||
-      (options.edge_model == EdgeModel::Automatic && ct.geometry.spacing.maxCoeff() <= kCortexModelMaxVoxelMm + 1e-6);
+      (options.edge_model == EdgeModel::Automatic &&
+       std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]) <= kCortexModelMaxInPlaneMm + 1e-6 &&
+       ct.geometry.spacing[2] <= kCortexModelMaxSliceMm + 1e-6);
   if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), shift, found);
   for (Eigen::Index v = 0; v < n; ++v) {

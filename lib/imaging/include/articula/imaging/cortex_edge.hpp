@@ -102,6 +102,7 @@ struct CortexTissue {
 struct CortexFit : CortexTissue {
   bool found = false;
   double offset_mm = 0;        // the outer (periosteal) surface along u
+  double gap_mm = 0;           // to the socket's step beyond it (where the model puts one)
   double sum_squares = 0;      // of the residuals (and of the held levels' departures, weighted), HU^2
 };
 
