@@ -107,7 +107,7 @@ struct CortexFit : CortexTissue {
 };
 
 /// The blurred-cortex model fitted to `line` with the steps blurred as
-/// `response` says, the surface searched within 1 mm of `guess_mm`. Where
+/// `response` says, the surface searched within cortexSearchMm of `guess_mm`. Where
 /// the voxels rise again beyond the edge (a socket across a joint gap), the
 /// window ends within that rise.
 /// With `held`, the cortex has the held thickness and its levels are drawn
@@ -160,11 +160,11 @@ struct PointSpread {
 /// slices (their shares summing to less than a tenth of the lines) give one
 /// width for both.
 /// Where the slices are more than a fifth longer than the in-plane voxel
-/// (tissueHeldAcrossSlices), the kind and the width within the slices come
-/// from the lines within them (slice share below kWithinSlicesShare), and
-/// the width across the slices from the other lines, each fitted with the
-/// tissue of its nearest lines within the slices (nearbyTissue): there a
-/// thin cortex's thickness trades against the blur.
+/// (tissueHeldAcrossSlices), the width across the slices is then estimated
+/// again on the lines across them (slice share kWithinSlicesShare or more),
+/// each fitted with the tissue of its nearest lines within the slices
+/// (nearbyTissue): across long slices a thin cortex's thickness trades
+/// against the blur, and the width with it.
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
 
 /// Lines whose slice share is below this lie within the slices: across
