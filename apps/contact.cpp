@@ -68,7 +68,10 @@ ConvexShape shapeFromFits(const std::filesystem::path& path, const std::string& 
                           const Eigen::Matrix3d& R_pose, const Vector3d& t_pose) {
   const nlohmann::json j = readJsonFile(path, "fits");
   try {
-    const std::string wanted = model_name.empty() ? j.at("best_model").get<std::string>() : model_name;
+    // The least-RMS model by default (written as "best_model" before "least_rms_model").
+    const std::string wanted = !model_name.empty()            ? model_name
+                               : j.contains("least_rms_model") ? j.at("least_rms_model").get<std::string>()
+                                                               : j.at("best_model").get<std::string>();
     for (const auto& m : j.at("models")) {
       if (m.at("model").get<std::string>() != wanted) continue;
       geometry::ShapeParameters p;
@@ -114,8 +117,8 @@ class ContactCommand : public cli::Command {
     auto* fits_a = app.add_option("--fits-a", fits_a_, "fits.json of surface A (articula-fit)");
     app.add_option("--fits-b", fits_b_, "fits.json of surface B")->needs(fits_a);
     fits_a->needs(app.get_option("--fits-b"));
-    app.add_option("--model-a", model_a_, "Model of A in its fits.json (default: its best_model)");
-    app.add_option("--model-b", model_b_, "Model of B in its fits.json (default: its best_model)");
+    app.add_option("--model-a", model_a_, "Model of A in its fits.json (default: its least_rms_model)");
+    app.add_option("--model-b", model_b_, "Model of B in its fits.json (default: its least_rms_model)");
     app.add_option("--pose-a", pose_a_, "Extra pose of A: tx,ty,tz (mm),phi,theta,psi (deg), R = Rx Ry Rz")
         ->delimiter(',')->expected(6);
     app.add_option("--pose-b", pose_b_, "Extra pose of B, as --pose-a")->delimiter(',')->expected(6);

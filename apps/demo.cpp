@@ -64,24 +64,28 @@ class DemoCommand : public cli::Command {
                   truth.at("radii_mm")[1].get<double>(), truth.at("radii_mm")[2].get<double>(), true_center[0],
                   true_center[1], true_center[2]);
     table << line;
-    std::snprintf(line, sizeof line, "%-15s %9s %9s %9s %9s %9s %12s\n", "model", "rms_mm", "a_mm", "b_mm", "c_mm",
-                  "bic", "centre_err_mm");
+    std::snprintf(line, sizeof line, "%-15s %9s %9s %9s %9s %7s %12s\n", "model", "rms_mm", "a_mm", "b_mm", "c_mm",
+                  "n_eff", "centre_err_mm");
     table << line;
     json rows = json::array();
+    const std::string selected = results.value("selected_model", ""), least = results.value("least_rms_model", "");
     for (const auto& m : results.at("models")) {
       const auto& p = m.at("parameters");
       const double a = p.at("a_mm"), b = p.value("b_mm", a), c = p.value("c_mm", a);
       const Eigen::Vector3d center(p.at("t1_mm"), p.at("t2_mm"), p.at("t3_mm"));
       const double centre_error = (center - true_center).norm();
       const double rms = m.at("errors").value("rms_mm", NAN);
-      std::snprintf(line, sizeof line, "%-15s %9.4f %9.3f %9.3f %9.3f %9.1f %12.3f%s\n",
-                    m.at("model").get<std::string>().c_str(), rms, a, b, c, m.value("bic", NAN), centre_error,
-                    m.at("model") == results.at("best_model") ? "  <- best" : "");
+      const std::string name = m.at("model").get<std::string>();
+      const double n_eff = m.contains("residual_correlation") ? m.at("residual_correlation").value("n_eff", NAN) : NAN;
+      // The one model results.json selects; the least RMS named only where it is another.
+      const std::string mark = name == selected ? "  <- selected" : name == least ? "  (least RMS, not selected)" : "";
+      std::snprintf(line, sizeof line, "%-15s %9.4f %9.3f %9.3f %9.3f %7.0f %12.3f%s\n", name.c_str(), rms, a, b, c,
+                    n_eff, centre_error, mark.c_str());
       table << line;
       rows.push_back({{"model", m.at("model")}, {"rms_mm", rms}, {"radii_mm", {a, b, c}}, {"center_error_mm", centre_error}});
     }
     if (common.verbosity > 0) std::fputs(table.str().c_str(), stderr);
-    const json demo = {{"truth", truth}, {"best_model", results.at("best_model")}, {"models", rows},
+    const json demo = {{"truth", truth}, {"selected_model", selected}, {"least_rms_model", least}, {"models", rows},
                        {"coordinate_system", "LPS"}, {"units", "mm"}};
     writeFileAtomically(output_ / "demo.json", demo.dump(2) + "\n");
     if (common.json) cli::printJson(demo);

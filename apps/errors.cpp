@@ -173,13 +173,14 @@ class ErrorsCommand : public cli::Command {
       file.commit();
     }
     writeFileAtomically(output_ / "histogram.svg",
-                        report::histogramSvg(series, "Signed Euclidean distances: " + input_.filename().string()),
+                        report::histogramSvg(series, "Signed Euclidean distances of the points to each model"),
                         overwrite);
-    // Maps about the best model's centre (fits.json's best_model, else the least RMS here).
+    // Maps about the least-RMS model's centre (fits.json's least_rms_model, or
+    // best_model in files before it, else the least RMS here).
+    const std::string key = doc.contains("least_rms_model") ? "least_rms_model" : "best_model";
     size_t best = 0;
     for (size_t m = 0; m < shapes.size(); ++m)
-      if (doc.contains("best_model") ? geometry::modelName(shapes[m].model) == doc["best_model"]
-                                     : rows[m].rms_mm < rows[best].rms_mm)
+      if (doc.contains(key) ? geometry::modelName(shapes[m].model) == doc[key] : rows[m].rms_mm < rows[best].rms_mm)
         best = m;
     std::vector<report::ErrorMapPanel> panels;
     for (size_t m = 0; m < shapes.size(); ++m) panels.push_back({rows[m].model, all.col(static_cast<Eigen::Index>(m))});
@@ -188,7 +189,7 @@ class ErrorsCommand : public cli::Command {
     map_options.highlight = rows[best].model;
     writeFileAtomically(output_ / "error_map.svg",
                         report::errorMapSvg(report::azimuthalEqualArea(P, shapes[best].center), panels, map_options,
-                                            "Signed distances to the fitted surfaces: " + input_.filename().string()),
+                                            "Signed distances to the fitted surfaces"),
                         overwrite);
     // Last: summary.json, then the marker goes: the folder is complete.
     writeFileAtomically(output_ / "summary.json",

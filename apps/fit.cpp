@@ -122,7 +122,9 @@ class FitCommand : public cli::Command {
     points::checkFittable(cloud, geometry::parameterCount(ShapeModel::Superovoid), input_.string());
     log::info("fitting " + std::to_string(cloud.positions.rows()) + " points from " + input_.string());
     const fit::Summary summary = fit::fitHierarchy(cloud.positions, o);
-    log::info(summary.fullReport());
+    // One line by default; each model's start and termination with -v.
+    log::info(summary.briefReport());
+    log::debug(summary.fullReport());
 
     nlohmann::json models = nlohmann::json::array();
     for (const auto& f : summary.fits) models.push_back(fit::modelFitJson(f));
@@ -134,7 +136,7 @@ class FitCommand : public cli::Command {
                           {"input", input_.string()},
                           {"n_points", cloud.positions.rows()},
                           {"objective", objective_},
-                          {"best_model", summary.best_model},
+                          {"least_rms_model", summary.best_model},
                           {"seconds", summary.seconds},
                           {"models", models},
                           {"provenance", provenanceJson({params, {input_}, common.seed})}};
@@ -142,7 +144,7 @@ class FitCommand : public cli::Command {
     writeFileAtomically(output_, doc.dump(2) + "\n", common.force);
     writeFileAtomically(csv, fitsCsv(summary), common.force);
     if (common.json)
-      cli::printJson({{"output", output_.string()}, {"csv", csv.string()}, {"best_model", summary.best_model},
+      cli::printJson({{"output", output_.string()}, {"csv", csv.string()}, {"least_rms_model", summary.best_model},
                       {"seconds", summary.seconds}});
     return 0;
   }

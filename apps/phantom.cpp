@@ -1,5 +1,6 @@
 // `articula phantom`: writes a synthetic hip CT of known femoral head shape
 // (NIfTI and a DICOM series) with its truth, the default input of the tests.
+#include <cstdio>
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -24,7 +25,8 @@ class PhantomCommand : public cli::Command {
   }
   std::string example() const override {
     return "articula phantom -o phantom --seed 3 --model ellipsoid --gap 2\n"
-           "  articula phantom -o pelvis --both-hips --radius-range 17,30 --gap 1.5 --spacing 1.5,1.5,3 --fovea --osteoporotic";
+           "  articula phantom -o pelvis --both-hips --radius-range 17,30 --gap 1.5 --spacing 1.5,1.5,3 --fovea --osteoporotic\n"
+           "  articula phantom -o arthritic --seed 2 --flattened-dome 0.15 --osteophytes 2 --cysts --narrow-gap 0.8";
   }
   void declare(CLI::App& app) override {
     app.add_option("-o,--output", output_, "Output folder (phantom.nii.gz, dicom/, truth.json)")->required();
@@ -58,6 +60,53 @@ class PhantomCommand : public cli::Command {
                  "whose first-order distance makes a 3 mm gap 3.2 mm and a 12 mm wall 16.6 mm on a 21 mm head)");
     app.add_flag("--both-hips", options_.both_hips,
                  "Both hips in one field of view with a pelvis-like frame; --side names the head of the top-level truth");
+    // Arthritis, on the --side head; truth.json's `departures` record each change.
+    app.add_option("--flattened-dome", options_.flattened_dome,
+                   "Arthritis: the head's weight-bearing dome flattened, cut by a plane this FRACTION (0-0.5) of its "
+                   "radius below its top (superior) and covered by new cortex, as a collapsed or worn femoral head")
+        ->capture_default_str();
+    app.add_option("--osteophytes", options_.osteophytes_mm,
+                   "Arthritis: a bony lip of this height (mm, up to 6) along the superior 150 degrees of the "
+                   "head-neck junction, as the osteophytes ringing an arthritic head")
+        ->capture_default_str();
+    app.add_flag("--cysts", options_.cysts,
+                 "Arthritis: three subchondral cysts, fluid-filled balls 2-5 mm across just under the cortex of the "
+                 "superior cap");
+    app.add_option("--narrow-gap", options_.narrow_gap_mm,
+                   "Arthritis: the joint space narrowed to this width (mm, 0.3 up to --gap) over a superior patch of "
+                   "the cap (within 20 degrees of superior, back to --gap at 32), as cartilage loss where the hip "
+                   "bears weight")
+        ->capture_default_str();
+    // What the scan adds; truth.json records each.
+    fov_cut_ = app.add_option("--fov-cut", fov_cut_value_,
+                   "A field of view that clips the --side head: the stored image ends at a plane across --fov-face "
+                   "with the head reaching this FRACTION of its radius beyond the last voxels (0: tangent, up to "
+                   "0.9), as a scan framed too tightly");
+    app.add_option("--fov-face", fov_face_,
+                   "The face of the field of view that --fov-cut moves in: +x, -x, +y, -y, +z, -z (LPS: left, right, "
+                   "posterior, anterior, superior, inferior; or L, R, P, A, S, I)")
+        ->capture_default_str();
+    app.add_option("--metal", metal_,
+                   "Metal on the --side femur: screw (a 6.5 mm lag screw along the neck into the head, as after a "
+                   "fixed neck fracture) or stem (a 12 mm stem in the shaft), at 8000 HU clipped to the scanner's "
+                   "3071, with streaks (bright and dark lines through the metal in each slice) and dark bands "
+                   "along and between its parts")
+        ->check(CLI::IsMember({"screw", "stem"}));
+    app.add_option("--kernel", kernel_,
+                   "Reconstruction kernel, within the slices: standard; soft (a further 0.6 mm Gaussian: smoother "
+                   "edges, fainter noise, as a soft-tissue kernel); sharp (edge enhancement with an overshoot at each "
+                   "edge and about twice the noise, correlated, as a bone kernel)")
+        ->check(CLI::IsMember({"standard", "soft", "sharp"}))->capture_default_str();
+    app.add_flag("--contrast-vessel", options_.contrast_vessel,
+                 "A 6 mm vessel filled with contrast (300 HU) running anterior-medial to the head, 5 mm off it, as "
+                 "the femoral artery in a CT angiogram");
+    app.add_flag("--table", options_.table,
+                 "The patient table: a curved slab (700 HU, 6 mm) under the patient's back with air beyond it, in "
+                 "the field of view (the grid grows 26 mm posteriorly)");
+    app.add_option("--slice-thickness", options_.slice_thickness_mm,
+                   "Slices thicker than their spacing (mm): each slice the mean over a box this wide across the "
+                   "slices, as a scan reconstructed at 3 mm and stored every 1.5 mm (0: the z spacing)")
+        ->capture_default_str();
     app.add_flag("--no-dicom", no_dicom_, "Skip the DICOM series");
   }
   int run(const cli::CommonOptions& common) override {
@@ -79,6 +128,20 @@ class PhantomCommand : public cli::Command {
     o.fovea = options_.fovea;
     o.both_hips = options_.both_hips;
     o.exact_depth = options_.exact_depth;
+    o.flattened_dome = options_.flattened_dome;
+    o.osteophytes_mm = options_.osteophytes_mm;
+    o.cysts = options_.cysts;
+    o.narrow_gap_mm = options_.narrow_gap_mm;
+    if (!metal_.empty()) o.metal = phantom::metalFromName(metal_);
+    o.kernel = phantom::kernelFromName(kernel_);
+    o.contrast_vessel = options_.contrast_vessel;
+    o.table = options_.table;
+    o.slice_thickness_mm = options_.slice_thickness_mm;
+    if (fov_cut_->count()) {
+      if (!(fov_cut_value_ >= 0)) throw UsageError("--fov-cut: expected a fraction of the radius from 0 to 0.9");
+      o.fov_cut = fov_cut_value_;
+      o.fov_face = phantom::faceDirection(fov_face_);
+    }
     if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer");
     o.seed = static_cast<unsigned long long>(common.seed);
     if (!model_.empty()) o.model = geometry::modelFromName(model_);
@@ -93,8 +156,11 @@ class PhantomCommand : public cli::Command {
     const std::vector<std::filesystem::path> old_slices = checkOutputs(common.force);
 
     const phantom::Phantom p = phantom::makePhantom(o);
-    log::info("phantom: " + p.truth["model"].get<std::string>() + " head at " + p.truth["head_center_mm"].dump() +
-              " mm, grid " + p.truth["grid"]["size"].dump());
+    const auto& centre = p.truth["head_center_mm"];
+    char at[96];
+    std::snprintf(at, sizeof at, "(%.2f, %.2f, %.2f)", centre[0].get<double>(), centre[1].get<double>(), centre[2].get<double>());
+    log::info("phantom: " + p.truth["model"].get<std::string>() + " head at " + at + " mm (LPS), grid " +
+              p.truth["grid"]["size"].dump());
     imaging::writeVolume(volume_path, p.ct, true);
     imaging::writeLabel(output_ / "femur_truth.nii.gz", p.femur, true);
     if (!no_dicom_) {
@@ -147,9 +213,11 @@ class PhantomCommand : public cli::Command {
   std::vector<double> radius_range_ = {20.0, 25.0};
   std::string socket_ = "congruent";
   double socket_cortical_hu_ = 0, socket_cancellous_hu_ = 0;
+  double fov_cut_value_ = 0;
+  std::string fov_face_ = "+z", metal_, kernel_ = "standard";
   phantom::PhantomOptions options_;  // holds the parsed values of the bone and socket options
   CLI::Option *radius_option_ = nullptr, *cortical_hu_ = nullptr, *cancellous_hu_ = nullptr, *cortical_mm_ = nullptr, *variation_ = nullptr,
-              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr;
+              *socket_cortical_ = nullptr, *socket_cancellous_ = nullptr, *fov_cut_ = nullptr;
 };
 
 ARTICULA_REGISTER_COMMAND(PhantomCommand)

@@ -30,13 +30,9 @@ class ReportCommand : public cli::Command {
     app.add_option("--side", options_.side, "right or left (recorded)")
         ->check(CLI::IsMember({"right", "left"}))
         ->capture_default_str();
-    app.add_option("--selection-floor", options_.selection_floor_mm,
-                   "RMS differences up to this many mm never tell models apart (systematic error of the CT surface)")
-        ->check(CLI::Range(0.0, 1.0))
-        ->capture_default_str();
-    app.add_option("--selection-tolerance", options_.selection_tolerance,
-                   "The selected model is the simplest whose RMS is within this fraction of the least RMS")
-        ->check(CLI::Range(0.0, 10.0))
+    app.add_option("--selection-alpha", options_.selection_alpha,
+                   "Level of the nested tests that take a richer model (with the residuals' correlation; 0: always the sphere)")
+        ->check(CLI::Range(0.0, 0.5))
         ->capture_default_str();
   }
   int run(const cli::CommonOptions& common) override {

@@ -75,7 +75,7 @@ class SampleCommand : public cli::Command {
     note << "articula sample: " << ds.original << " selected, " << ds.reduced << " kept, open ball " << down_.ball_radius_mm
          << " mm, seed " << common.seed;
     points::writePoints(output_, cloud, {note.str()}, true);
-    log::info(note.str() + " (" + ds.termination + ")");
+    log::info("sample: " + note.str().substr(std::string("articula sample: ").size()) + " (" + ds.termination + ")");
 
     nlohmann::json params = {{"select", select_},
                              {"ball_radius_mm", down_.ball_radius_mm},

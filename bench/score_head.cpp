@@ -1,9 +1,12 @@
 // bench-score-head TRUTH.json SIDE POINTS.ply [RESULTS.json]: scores a run's
 // articular points against a phantom's true head of the given side (the
-// exact signed distance of lib/distance to the head less its fovea pit).
+// exact signed distance of lib/distance to the head less its fovea pit, with
+// its arthritic departures: a flattened dome's cut, osteophytes).
 // Prints one JSON line: n_points, rms_mm, mean_signed_mm (positive outside),
-// share_within_1p5_mm, max_abs_mm and, with RESULTS.json, centre_error_mm
-// (results' head_center_mm to the true centre). Used by bench/robustness.py.
+// share_within_1p5_mm, max_abs_mm, model_rms_mm (to the head's model alone:
+// differs from rms_mm where the head departs from its model) and, with
+// RESULTS.json, centre_error_mm (results' head_center_mm to the true centre).
+// Used by bench/robustness.py and bench/clinical.py.
 // ARTICULA_SCORE_POINTS=FILE also writes each point's x,y,z,signed distance
 // (mm) as CSV, to see where a head goes wrong.
 #include <cmath>
@@ -16,31 +19,6 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/phantom/phantom.hpp"
 #include "articula/points/point_io.hpp"
-
-namespace {
-
-Eigen::Vector3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
-
-// The truth.json keys written by lib/phantom back into a Hip.
-articula::phantom::Hip hipFromTruth(const nlohmann::json& t) {
-  articula::phantom::Hip hip;
-  hip.right = t["side"] == "right";
-  articula::geometry::ShapeParameters& p = hip.head;
-  p.model = articula::geometry::modelFromName(t["model"].get<std::string>());
-  p.radii = vec3(t["radii_mm"]);
-  p.exponents = vec3(t["exponents"]);
-  for (int n = 0; n < 4; ++n) p.cx[n] = t["cx"][n].get<double>(), p.cy[n] = t["cy"][n].get<double>();
-  p.center = vec3(t["head_center_mm"]);
-  p.angles = vec3(t["angles_rad"]);
-  if (t.contains("fovea")) {
-    hip.fovea = true;
-    hip.fovea_center = vec3(t["fovea"]["center_mm"]);
-    hip.fovea_radius_mm = t["fovea"]["radius_mm"].get<double>();
-  }
-  return hip;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 4) {
@@ -61,7 +39,7 @@ int main(int argc, char** argv) {
       std::cerr << argv[1] << ": no " << side << " hip in hips[]\n";
       return 3;
     }
-    const articula::phantom::Hip hip = hipFromTruth(*head);
+    const articula::phantom::Hip hip = articula::phantom::hipFromTruth(*head);
     const articula::distance::SignedDistance exact(hip.head);
     const articula::points::PointCloud cloud = articula::points::readPoints(argv[3]);
     const Eigen::Index n = cloud.positions.rows();
@@ -70,11 +48,13 @@ int main(int argc, char** argv) {
       per_point.open(file);
       per_point << "x,y,z,signed_mm\n";
     }
-    double sum = 0, sum2 = 0, max_abs = 0;
+    double sum = 0, sum2 = 0, max_abs = 0, model2 = 0;
     long within = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Vector3d x = cloud.positions.row(i).transpose();
-      const double d = articula::phantom::headSurfaceDistance(hip, exact.closest(x).distance, x);
+      const double to_model = exact.closest(x).distance;
+      const double d = articula::phantom::headSurfaceDistance(hip, to_model, x);
+      model2 += to_model * to_model;
       if (per_point.is_open()) per_point << x.x() << ',' << x.y() << ',' << x.z() << ',' << d << '\n';
       sum += d;
       sum2 += d * d;
@@ -85,10 +65,12 @@ int main(int argc, char** argv) {
                           {"rms_mm", n ? std::sqrt(sum2 / n) : NAN},
                           {"mean_signed_mm", n ? sum / n : NAN},
                           {"share_within_1p5_mm", n ? double(within) / n : 0.0},
-                          {"max_abs_mm", max_abs}};
+                          {"max_abs_mm", max_abs},
+                          {"model_rms_mm", n ? std::sqrt(model2 / n) : NAN}};
     if (argc > 4) {
       const nlohmann::json results = nlohmann::json::parse(std::ifstream(argv[4]));
-      out["centre_error_mm"] = (vec3(results["head_center_mm"]) - hip.head.center).norm();
+      const nlohmann::json& c = results["head_center_mm"];
+      out["centre_error_mm"] = (Eigen::Vector3d(c[0].get<double>(), c[1].get<double>(), c[2].get<double>()) - hip.head.center).norm();
     }
     std::cout << out.dump() << "\n";
   } catch (const std::exception& e) {

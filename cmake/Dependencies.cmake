@@ -42,6 +42,11 @@ find_package(VTK 9.1 QUIET COMPONENTS CommonCore CommonDataModel CommonTransform
   FiltersCore FiltersGeneral FiltersModeling IOXML IOGeometry IOPLY IOLegacy)
 articula_require(VTK_FOUND libvtk9-dev)
 
+# Boost.Math (headers only): the chi-square and binomial distributions of
+# the model selection's tests.
+find_package(Boost 1.74 QUIET)
+articula_require(Boost_FOUND libboost-dev)
+
 set(CGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE TRUE)
 find_package(CGAL QUIET)
 articula_require(CGAL_FOUND libcgal-dev)

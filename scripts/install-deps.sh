@@ -13,6 +13,8 @@ PACKAGES=(
   build-essential cmake git pkg-config libssl-dev
   libinsighttoolkit5-dev libvtk9-dev libcgal-dev libeigen3-dev
   libnlopt-cxx-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
+  # the distributions of the model selection's tests (Boost.Math, headers)
+  libboost-dev
   # the multibody engine of lib/dynamics
   libsimbody-dev
   # the reports' 3-D view, inlined at build time
@@ -27,8 +29,9 @@ DEVELOPMENT_PACKAGES=(
   chromium python3-jsonschema
   # the independent hip phantoms of the tests and bench/
   python3-numpy python3-scipy
-  # studies that outgrow one machine (pipelines/Snakefile)
-  snakemake
+  # studies that outgrow one machine (pipelines/Snakefile), and the
+  # single-node Slurm cluster its Slurm profile is tested on (tests/apps/slurm.sh)
+  snakemake slurmctld slurmd slurm-client munge
   # the sanitizer tier and fuzzing (scripts/sanitize.sh, scripts/fuzz.sh):
   # Clang and its libFuzzer runtime
   clang libclang-rt-14-dev

@@ -50,15 +50,15 @@ summary = {r["model"]: r for r in csv.DictReader(open(f"{sys.argv[1]}/study_summ
 assert [summary[m]["times_selected"] for m in ("sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid")] == \
     ["1", "1", "1", "0", "0"], summary
 PY
-# A new --selection-tolerance reruns only the report: with 10 (any RMS
-# within 11x of the least) the superellipsoid phantom's points select the sphere.
+# A new --selection-alpha reruns only the report: at 0 no richer model
+# passes its test, and the superellipsoid phantom's points select the sphere.
 dir="$tmp/killed/subjects/s3"
 read -r input seed < <(python3 -c '
 import json, sys
 a = json.load(open(sys.argv[1]))["args"]
 print(a[a.index("-i") + 1], a[a.index("--seed") + 1])' "$dir/.articula/segment.json")
 "$bin/articula" run -i "$input" -o "$dir" --joint hip --side right --seed "$seed" --threads 1 \
-  --selection-tolerance 10 2> "$tmp/tolerance.err" || { cat "$tmp/tolerance.err" >&2; fail "run --selection-tolerance failed"; }
+  --selection-alpha 0 2> "$tmp/tolerance.err" || { cat "$tmp/tolerance.err" >&2; fail "run --selection-alpha failed"; }
 for stage in segment mesh sample fit errors; do
   grep -q "run: $stage is up to date" "$tmp/tolerance.err" || { cat "$tmp/tolerance.err" >&2; fail "$stage was redone"; }
 done
@@ -66,8 +66,9 @@ grep -q "run: \[6/6\] report \.\.\." "$tmp/tolerance.err" || { cat "$tmp/toleran
 python3 - "$dir/results.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
-assert r["selection"]["relative_tolerance"] == 10, r["selection"]
+assert r["selection"]["alpha"] == 0, r["selection"]
 assert r["selected_model"] == "sphere", r["selected_model"]
-assert r["best_model"] != "sphere", r["best_model"]
+assert r["least_rms_model"] != "sphere", r["least_rms_model"]
+assert not any(s["richer_needed"] for s in r["selection"]["path"]), r["selection"]["path"]
 PY
 echo "killed batch resumed: ok"

@@ -51,8 +51,10 @@ qc = results["qc"]
 # The selected model's radii the points do not determine carry no interval on the page.
 model = next(m for m in results["models"] if m["model"] == results["selected_model"])
 open_radii = [r for r in ("a", "b", "c") if r in model["not_identifiable"]]
-cell = re.search(r'<td id="radii">(.*?)</td>', open(sys.argv[1].replace("results.json", "report.html")).read()).group(1)
-assert cell.count("(not determined)") == len(open_radii), (open_radii, cell)
+cell = re.search(r'<td id="(?:radii|semi-axes)">(.*?)</td>', open(sys.argv[1].replace("results.json", "report.html")).read()).group(1)
+assert cell.count("not determined") == len(open_radii), (open_radii, cell)
+# A model the points leave open is never selected.
+assert results["selected_model"] not in results["selection"]["undetermined"], results["selection"]
 checks = {c["name"]: c for c in qc["checks"]}
 print(f"thorax {side}: qc {qc['status']}: " + "; ".join(qc.get("reasons", [])))
 assert qc["status"] == "fail", qc["status"]

@@ -14,11 +14,11 @@ csv_value() {
 
 expect_rc 0 "$bin/articula-fit" -i "$tmp/so.ply" -o "$tmp/fits.json" --seed 7
 [ -s "$tmp/fits.json" ] && [ -s "$tmp/fits.csv" ] || fail "fits.json and fits.csv written"
-for key in '"best_model"' '"coordinate_system": "LPS"' '"center_mm"' '"radii_mm"' '"rotation_deg"' \
+for key in '"least_rms_model"' '"coordinate_system": "LPS"' '"center_mm"' '"radii_mm"' '"rotation_deg"' \
            '"rotation_matrix"' '"exponents"' '"cx"' '"cy"' '"termination"' '"converged"' '"sha256"' '"seed": 7'; do
   grep -q "$key" "$tmp/fits.json" || fail "fits.json has $key"
 done
-grep -q '"best_model": "superovoid"' "$tmp/fits.json" || fail "best model is the true superovoid"
+grep -q '"least_rms_model": "superovoid"' "$tmp/fits.json" || fail "the least RMS is the true superovoid"
 se_a=$(csv_value "$tmp/fits.csv" sphere a_se_mm)
 python3 -c "import sys; se = float(sys.argv[1]); assert 0 < se < 0.5, se" "$se_a" || fail "the sphere's radius has no plausible standard error in fits.csv: '$se_a'"
 rms_so=$(csv_value "$tmp/fits.csv" superovoid rms_mm)
@@ -67,8 +67,8 @@ limit = float(re.search(r'data-limit-mm="([^"]+)"', svg).group(1))
 # Points at or beyond -limit (rounded to the nearest step) take the darkest red.
 deep = sum(1 for r in rows for m in models if float(r[f"d_{m}_mm"]) <= -limit * 0.95)
 assert dots.get("#b2182b", 0) == deep, (dots.get("#b2182b"), deep, limit)
-best = json.load(open(sys.argv[2]))["best_model"]
-assert f"{best}: RMS" in svg and "(best)" in svg, best
+best = json.load(open(sys.argv[2]))["least_rms_model"]
+assert f"{best}: RMS" in svg and "(least RMS)" in svg, best
 PY
 [ "$(wc -l < "$tmp/report/errors.csv")" -eq "$(( $(grep -m1 'element vertex' "$tmp/so.ply" | awk '{print $3}') + 1 ))" ] \
   || fail "errors.csv has one row per point"

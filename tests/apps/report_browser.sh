@@ -126,12 +126,18 @@ print(f"report ok: {drawn} of {len(inside)} canvas samples drawn")
 PY
 done
 
-# study.html: no console message, every link resolves to a file of the study.
+# study.html: no console message, every link resolves to a file of the study;
+# the review desk starts from the study's ratings.csv and writes the same
+# file back (the reviewer's "Save ratings.csv").
+printf 'subject,decision,note\np1,include,"checked, ""fine"""\n' > "$tmp/study/ratings.csv"
+"$bin/articula" batch "$tmp/study.csv" -o "$tmp/study" --gather-only --quiet 2> /dev/null || true
 browse "file://$tmp/study/study.html" --dump-dom > "$tmp/study-dom.html" 2> "$tmp/study-console.err"
 check_console "$tmp/study-console.err" study.html
 /usr/bin/env python3 - "$tmp/study-dom.html" "$tmp/study" <<'PY'
-import os, re, sys, urllib.parse
+import html, os, re, sys, urllib.parse
 dom, study = open(sys.argv[1]).read(), sys.argv[2]
+saved = html.unescape(re.search(r'<textarea id="ratings-csv"[^>]*>(.*?)</textarea>', dom, re.S).group(1))
+assert saved == open(os.path.join(study, "ratings.csv")).read(), saved
 assert "data-page-problems" not in re.search(r"<html[^>]*>", dom).group(0)
 links = re.findall(r'href="([^"#]*)', dom)
 assert len(links) >= 5, links

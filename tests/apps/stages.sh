@@ -18,7 +18,7 @@ assert names == ["segment", "mesh", "sample", "fit", "errors", "report"], names
 by = {s["name"]: s for s in stages}
 assert "series-uid" in by["segment"]["options"] and "series-uid" in by["mesh"]["options"]
 assert "smoothing" in by["mesh"]["options"], by["mesh"]
-assert by["report"]["options"] == ["series-uid", "selection-tolerance", "selection-floor"], by["report"]
+assert by["report"]["options"] == ["series-uid", "selection-alpha"], by["report"]
 assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"]
 assert "CT" in by["mesh"]["inputs"]
 # Every stage's command line names the files it reads and the first it writes
@@ -65,11 +65,20 @@ assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
 assert not re.search(r'<(link|img|iframe)\b|<script[^>]*\bsrc\b', html), "external content"
 assert "content=\"default-src 'none';" in html, "no content security policy"
 assert not re.search(r'\b(src|href)\s*=\s*"(?!#|data:image/png;base64,)', html), "a reference leaves the page"
-# Three CT slices through the head, each an embedded PNG with the label's edge and the model's outline.
+# Nine CT slices, three per plane (through the centre and half a radius to
+# either side), each an embedded PNG with the label's edge and the model's
+# outline, orientation letters, a 10 mm scale bar and its position.
 import base64, struct
 slices = re.findall(r'<svg[^>]*class="slice" data-plane="(\w+)".*?href="data:image/png;base64,([^"]+)".*?'
                     r'class="label-edge" d="([^"]*)".*?class="model-outline" d="([^"]*)"', html, re.S)
-assert [s[0] for s in slices] == ["axial", "coronal", "sagittal"], [s[0] for s in slices]
+assert [s[0] for s in slices] == ["axial"] * 3 + ["coronal"] * 3 + ["sagittal"] * 3, [s[0] for s in slices]
+letters = re.findall(r'<g class="orientation"[^>]*>(.*?)</g>', html)
+assert len(letters) == 9 and all(re.findall(r">([A-Z])</text>", g) for g in letters), letters[:1]
+assert re.findall(r">([A-Z])</text>", letters[0]) == ["R", "L", "A", "P"], letters[0]
+assert re.findall(r">([A-Z])</text>", letters[8]) == ["A", "P", "S", "I"], letters[8]
+assert html.count('class="scale-bar"') == 9 and ">10 mm</text>" in html
+captions = re.findall(r"<figcaption>((?:axial|coronal|sagittal)[^<]*)</figcaption>", html)
+assert len(captions) == 9 and captions[1].startswith("axial, z = ") and captions[1].endswith("(centre)"), captions
 for plane, png, edge, outline in slices:
     png = base64.b64decode(png)
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR", plane
@@ -90,8 +99,28 @@ for m in r["models"]:
     want = [p["a_mm"] * p.get("c0x", 1), p.get("b_mm", p["a_mm"]) * p.get("c0y", 1), p.get("c_mm", p["a_mm"])]
     assert all(abs(x - y) <= 1e-9 * y for x, y in zip(axes, want)), (m["model"], axes, want)
     if "c0x" in p and m["model"] == selected:
-        assert re.search(r'id="semi-axes">%.2f, %.2f, %.2f' % tuple(axes), html), "semi-axes not shown"
+        assert re.search(r'id="semi-axes">' + r'(?: &plusmn; [0-9.]+)?, '.join("%.2f" % x for x in axes), html), "semi-axes not shown"
 assert 'class="status %s"' % r["qc"]["status"] in html
+# The selection's evidence: the hierarchy's five steps, each a nested F test
+# with the two models' n_eff, and the walk that chose the model; on the
+# page as a table; the least-RMS model named only where it is another.
+sel = r["selection"]
+assert [(st["simpler"], st["richer"]) for st in sel["steps"]] == [
+    ("sphere", "ellipsoid"), ("ellipsoid", "superellipsoid"), ("ellipsoid", "ovoid"),
+    ("superellipsoid", "superovoid"), ("ovoid", "superovoid")], sel["steps"]
+by_model = {m["model"]: m for m in r["models"]}
+for st in sel["steps"] + sel["path"]:
+    assert 0 <= st["p_value"] <= 1 and st["f"] >= 0 and st["richer_needed"] == (st["p_value"] < st["alpha"]), st
+    both = by_model[st["simpler"]]["residual_correlation"]["n_eff"] * by_model[st["richer"]]["residual_correlation"]["n_eff"]
+    assert abs(st["n_eff"] - both ** 0.5) < 1e-6 * st["n_eff"], st  # the geometric mean of the two models' n_eff
+    assert 1 <= st["n_eff"] <= by_model[st["richer"]]["errors"]["n_points"], st
+assert sel["path"] and sel["path"][0]["simpler"] == "sphere", sel["path"]
+# The walk ends where no richer model passes: the selected model's own tests all fail.
+assert not any(st["richer_needed"] for st in sel["path"] if st["simpler"] == selected), sel["path"]
+assert selected not in sel["undetermined"]
+assert html.count('<tr class="step">') == 5 and html.count('<tr class="path">') == len(sel["path"]), "selection table"
+assert ('id="least-rms"' in html) == (r["least_rms_model"] != selected)
+assert "best" not in re.sub(r"<[^>]+>", "", html.split('id="verdict"')[1].split("</section>")[0]).lower()
 assert html.count("<svg") >= 2, "the error figures are not inline"
 methods = re.search(r'<p id="methods">(.*?)</p>', html, re.S).group(1)
 assert "The %s was selected" % selected in methods and r["provenance"]["git_commit"] in methods, methods
@@ -100,8 +129,8 @@ edges = json.load(open(os.path.join(os.path.dirname(sys.argv[2]), "bone.vtp.json
 assert ("blurred-cortex model" in methods) == (edges["edge_model"] == "cortex"), methods
 assert "steepest fall" in methods, methods
 PY
-expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force --selection-floor 1
-grep -q '"selected_model": "sphere"' "$tmp/r/results.json" || fail "--selection-floor 1 should select the sphere"
+expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force --selection-alpha 0
+grep -q '"selected_model": "sphere"' "$tmp/r/results.json" || fail "--selection-alpha 0 should select the sphere"
 
 # With the blurred-cortex edges (the default on voxels up to 0.8 mm; asked
 # for here), the methods say so, with the point-spread the mesh stage used.
@@ -125,7 +154,7 @@ grep -q "needs '.*fits.json', which is missing" "$tmp/err" || fail "missing fits
 [ ! -e "$tmp/r2/results.json" ] || fail "a results.json was written without fits"
 
 # A report option out of range stops run before its first stage.
-expect_rc 2 "$bin/articula" run -i "$ct" -o "$tmp/r3" --selection-floor 5
-grep -q "the report stage: --selection-floor" "$tmp/err" || fail "run names the stage: $(cat "$tmp/err")"
+expect_rc 2 "$bin/articula" run -i "$ct" -o "$tmp/r3" --selection-alpha 5
+grep -q "the report stage: --selection-alpha" "$tmp/err" || fail "run names the stage: $(cat "$tmp/err")"
 [ ! -e "$tmp/r3/label.nii.gz" ] || fail "run segmented before refusing the option"
 echo "stages: ok"

@@ -72,6 +72,15 @@ for s in ("p1", "p2"):
 summary = {r["model"]: r for r in csv.DictReader(open(f"{study}/study_summary.csv"))}
 assert set(summary) == models and summary["sphere"]["n_subjects"] == "2"
 assert summary["ellipsoid"]["wilcoxon_p_vs_sphere"] != ""
+# Per step of the hierarchy: the subjects needing the richer model, the
+# cohort's tests, agreeing with each subject's own step in study.csv.
+steps = {(r["simpler"], r["richer"]): r for r in csv.DictReader(open(f"{study}/study_steps.csv"))}
+assert set(steps) == {("sphere", "ellipsoid"), ("ellipsoid", "superellipsoid"), ("ellipsoid", "ovoid"),
+                      ("superellipsoid", "superovoid"), ("ovoid", "superovoid")}, steps
+needed = sum(r["richer_needed"] == "1" for r in rows if r["model"] == "ellipsoid")
+assert steps[("sphere", "ellipsoid")]["subjects"] == "2" and int(steps[("sphere", "ellipsoid")]["richer_needed"]) == needed, steps
+assert 0 <= float(steps[("sphere", "ellipsoid")]["fisher_p"]) <= 1 and 0 < float(steps[("sphere", "ellipsoid")]["sign_test_p"]) <= 1
+assert all(r["n_eff"] and 0 < float(r["n_eff"]) <= float(r["n_points"]) for r in rows), rows
 # study.svg: one line per good subject, one dot per subject x model, the means of study_summary.csv.
 import re
 svg = open(f"{study}/study.svg").read()
@@ -94,6 +103,7 @@ for s in ("missing", "baddicom"):
     row = re.search(r'<tr class="failed"><td>.*?%s.*?</tr>' % s, html)
     assert row and status[s]["message"][:40].replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;").replace("'", "&#39;") in row.group(0), s
 assert re.search(r'<span id="failed">2</span>', html)
+assert 'id="cohort-steps"' in html and "Semi-axis a of the selected model" in html, "cohort steps or semi-axis plots missing"
 for s in ("p1", "p2"):
     assert html.count('href="subjects/%s/report.html"' % s) >= 5, s  # one dot per RMS plot at least
     assert os.path.exists(f"{study}/subjects/{s}/report.html")
@@ -112,16 +122,16 @@ echo "batch: first run ${first}s, rerun ${second}s"
 if command -v snakemake > /dev/null; then
   # Stage options as manifest columns (the sample's and the report's): both
   # runners must pass them on, from the one stage table.
-  grep -v -e missing -e baddicom "$tmp/study.csv" | sed -e '1s/$/,ball_radius,selection_floor/' -e '2,$s/$/,1.2,1.0/' \
+  grep -v -e missing -e baddicom "$tmp/study.csv" | sed -e '1s/$/,ball_radius,selection_alpha/' -e '2,$s/$/,1.2,0/' \
     > "$tmp/good.csv"
   # An out-of-range stage option is refused by --validate, naming the stage.
-  sed -e '2s/,1.0$/,5/' "$tmp/good.csv" > "$tmp/bad-option.csv"
+  sed -e '2s/,0$/,5/' "$tmp/good.csv" > "$tmp/bad-option.csv"
   set +e
   "$bin/articula" batch "$tmp/bad-option.csv" -o "$tmp/bad-option" --validate 2> "$tmp/bad-option.err"
   rc=$?
   set -e
-  [ "$rc" -eq 3 ] || { cat "$tmp/bad-option.err" >&2; fail "--validate with --selection-floor 5 exited $rc, expected 3"; }
-  grep -q "the report stage: --selection-floor" "$tmp/bad-option.err" || fail "validate names the stage: $(cat "$tmp/bad-option.err")"
+  [ "$rc" -eq 3 ] || { cat "$tmp/bad-option.err" >&2; fail "--validate with --selection-alpha 5 exited $rc, expected 3"; }
+  grep -q "the report stage: --selection-alpha" "$tmp/bad-option.err" || fail "validate names the stage: $(cat "$tmp/bad-option.err")"
   "$bin/articula" batch "$tmp/good.csv" -o "$tmp/batch-good" -j 2 --quiet
   snakemake -s "$src/pipelines/Snakefile" --profile "$src/pipelines/profiles/local" --quiet \
     --config manifest="$tmp/good.csv" study="$tmp/snake" bin="$bin" > "$tmp/snake.log" 2>&1 ||
@@ -133,10 +143,10 @@ if command -v snakemake > /dev/null; then
   [ -s "$tmp/snake/subjects/p1/scene.mrml" ] || fail "snakemake wrote no scene.mrml"
   [ -s "$tmp/snake/subjects/p1/errors/error_map.svg" ] || fail "snakemake error_map.svg"
   # Same seed, same outputs (batch-good vs the first batch, subject p2).
-  # The columns took effect: a 1 mm floor selects the sphere, and a wider
+  # The columns took effect: a level of 0 selects the sphere, and a wider
   # open ball keeps fewer points than the first batch's default.
   for subject in p1 p2; do
-    grep -q '"selected_model": "sphere"' "$tmp/snake/subjects/$subject/results.json" || fail "snakemake: selection_floor ignored"
+    grep -q '"selected_model": "sphere"' "$tmp/snake/subjects/$subject/results.json" || fail "snakemake: selection_alpha ignored"
     [ "$(wc -c < "$tmp/snake/subjects/$subject/points.ply")" -lt "$(wc -c < "$tmp/study/subjects/$subject/points.ply")" ] ||
       fail "snakemake: ball_radius ignored"
   done
@@ -146,6 +156,26 @@ if command -v snakemake > /dev/null; then
   cmp "$tmp/study/subjects/p2/points.ply" "$tmp/batch-again/subjects/p2/points.ply" || fail "same seed, different points"
   cmp "$tmp/study/subjects/p2/results.csv" "$tmp/batch-again/subjects/p2/results.csv" || fail "same seed, different fits"
   cmp "$tmp/batch-good/subjects/p2/results.csv" "$tmp/snake/subjects/p2/results.csv" || fail "snakemake and batch, different fits"
+  # A reviewer excludes p1 (ratings.csv in the study folder): the Snakefile
+  # gathers the study again, and batch --gather-only gives the same tables.
+  printf 'subject,decision,note\np1,exclude,"motion, rescanned"\np2,include,\n' | tee "$tmp/snake/ratings.csv" \
+    > "$tmp/batch-good/ratings.csv"
+  snakemake -s "$src/pipelines/Snakefile" --profile "$src/pipelines/profiles/local" --quiet \
+    --config manifest="$tmp/good.csv" study="$tmp/snake" bin="$bin" > "$tmp/snake-rated.log" 2>&1 ||
+    { tail -30 "$tmp/snake-rated.log" >&2; fail "snakemake after the ratings"; }
+  "$bin/articula" batch "$tmp/good.csv" -o "$tmp/batch-good" --gather-only --quiet
+  diff "$tmp/batch-good/study.csv" "$tmp/snake/study.csv" || fail "rated: snakemake study.csv differs from batch"
+  ! grep -q '^p1,' "$tmp/snake/study.csv" || fail "the excluded p1 is still in study.csv"
+  grep -q '^p2,' "$tmp/snake/study.csv" || fail "p2 is missing from study.csv"
+  grep -q '^p1,ok,0,.*,exclude,"motion, rescanned"$' "$tmp/snake/study_status.csv" ||
+    fail "study_status.csv does not record the exclusion: $(cat "$tmp/snake/study_status.csv")"
+  grep -q '"excluded": 1' "$tmp/snake/study.json" || fail "study.json does not count the excluded"
+  grep -q '<td>p1</td><td>motion, rescanned</td>' "$tmp/snake/study.html" || fail "study.html does not list p1 as excluded"
+  # A decision the study does not know: refused, the line named.
+  printf 'subject,decision,note\np1,maybe,\n' > "$tmp/batch-good/ratings.csv"
+  expect_rc 3 "$bin/articula" batch "$tmp/good.csv" -o "$tmp/batch-good" --gather-only
+  grep -q "ratings.csv' line 2: expected the decision include or exclude, found 'maybe'" "$tmp/err" ||
+    fail "a bad decision: $(cat "$tmp/err")"
 else
   echo "snakemake not installed: Snakemake comparison skipped" >&2
 fi

@@ -4,8 +4,8 @@
 // a side the search could not tell, points inside the bone, a shell label
 // off the CT's edges at coarse voxels, a socket's outer surface that faces
 // no socket, a head on the body's midline); a cortex blurred away across
-// the slices warns, and so does a head at the other joint's distance from
-// the body's middle.
+// the slices warns, and so do a head at the other joint's distance from
+// the body's middle and a field of view that ends inside the head.
 #include <cmath>
 #include <functional>
 
@@ -51,7 +51,24 @@ TEST(HeadQc, AFemoralHeadsCapPasses) {
   const pipeline::QcReport r = pipeline::checkHead(in);
   EXPECT_EQ(r.status, "pass") << r.toJson().dump();
   EXPECT_TRUE(r.reasons().empty());
-  EXPECT_EQ(r.checks.size(), 6u);
+  EXPECT_EQ(r.checks.size(), 7u);
+  EXPECT_EQ(check(r, "stage_warnings").value, 0);
+}
+
+TEST(HeadQc, AStagesWarningAndASurfaceLeftOnTheLabelAreNamedChecks) {
+  pipeline::HeadQcInput in = cap(23, 85);
+  in.stage_warnings = {"2 file(s) of ct/ are in no DICOM series", "the search took the larger head"};
+  in.surface_on_ct_edges = false;
+  const pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(r.status, "warn");
+  const pipeline::QcCheck& warned = check(r, "stage_warnings");
+  EXPECT_EQ(warned.status, "warn");
+  EXPECT_EQ(warned.value, 2);
+  EXPECT_NE(warned.reason.find("no DICOM series; the search took the larger head"), std::string::npos) << warned.reason;
+  EXPECT_EQ(check(r, "surface_on_ct_edges").status, "warn");
+  EXPECT_NE(check(r, "surface_on_ct_edges").reason.find("voxel staircase"), std::string::npos);
+  // Neither is a doubt about the structure: two of them do not fail the head.
+  EXPECT_FALSE(warned.of_structure);
 }
 
 TEST(HeadQc, ASocketsInnerSurfaceFailsOnItsNormals) {
@@ -156,6 +173,48 @@ TEST(HeadQc, AHeadTheFieldOfViewClipsWarnsOrFails) {
   const pipeline::QcReport r = pipeline::checkHead(in);
   EXPECT_EQ(check(r, "head_outside_volume_share").status, "fail");
   EXPECT_NE(check(r, "head_outside_volume_share").reason.find("the field of view clips the head"), std::string::npos);
+}
+
+// A field of view that ends on the neck's side: a face 0.9 r from the centre
+// towards -z, where the cap's points (about +z) put the neck. The share
+// leaves the neck's cone out and misses the cut; how far the sphere reaches
+// beyond the last voxels (0.1 of the radius, a tenth of the radius cut)
+// names it, on every face and orientation of the grid.
+TEST(HeadQc, AFieldOfViewCutOnTheNecksSideWarns) {
+  const auto grid = [](const Eigen::Vector3d& face, bool ras) {
+    imaging::ImageGeometry g;  // 1 x 1 x 1.5 mm over +-39 mm about the centre 0, cut at 18 mm on `face`
+    g.spacing = Eigen::Vector3d(1, 1, 1.5);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(-39), hi = Eigen::Vector3d::Constant(39);
+    for (int a = 0; a < 3; ++a)
+      if (face[a] > 0) hi[a] = 18; else if (face[a] < 0) lo[a] = -18;
+    for (int a = 0; a < 3; ++a) g.size[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / g.spacing[a])) + 1;
+    g.origin = lo;
+    if (ras) {
+      g.direction = Eigen::Vector3d(-1, -1, 1).asDiagonal();
+      g.origin = Eigen::Vector3d(lo[0] + (g.size[0] - 1) * g.spacing[0], lo[1] + (g.size[1] - 1) * g.spacing[1], lo[2]);
+    }
+    return g;
+  };
+  pipeline::HeadQcInput in = cap(20, 80);
+  in.points.rowwise() -= in.sphere_center.transpose();
+  in.sphere_center.setZero();
+  const imaging::ImageGeometry neck_side = grid(-Eigen::Vector3d::UnitZ(), false);
+  EXPECT_LT(pipeline::headOutsideVolumeShare(neck_side, in.points, in.sphere_center, 20), 0.02);
+  for (int a = 0; a < 3; ++a)
+    for (double sign : {-1.0, 1.0})
+      for (bool ras : {false, true}) {
+        const Eigen::Vector3d face = sign * Eigen::Vector3d::Unit(a);
+        EXPECT_NEAR(pipeline::headBeyondFieldOfView(grid(face, ras), in.sphere_center, 20), 2.0, 1e-9) << face.transpose();
+      }
+  EXPECT_EQ(pipeline::headBeyondFieldOfView(grid(Eigen::Vector3d::Zero(), false), in.sphere_center, 20), 0.0);
+  in.head_beyond_fov_mm = pipeline::headBeyondFieldOfView(neck_side, in.sphere_center, 20);
+  pipeline::QcReport r = pipeline::checkHead(in);
+  EXPECT_EQ(check(r, "head_beyond_fov_relative").status, "warn");
+  EXPECT_NEAR(check(r, "head_beyond_fov_relative").value, 0.1, 1e-9);
+  EXPECT_NE(check(r, "head_beyond_fov_relative").reason.find("the field of view ends inside the head"), std::string::npos);
+  EXPECT_EQ(r.status, "warn");  // of the data's coverage: no doubt about the structure
+  in.head_beyond_fov_mm = 0.5;  // 0.025 of the radius: a tangent's reach
+  EXPECT_EQ(check(pipeline::checkHead(in), "head_beyond_fov_relative").status, "pass");
 }
 
 TEST(HeadQc, AHeadTheSearchTookByItsFallbackWarns) {

@@ -187,7 +187,10 @@ int runCommandInProcess(const std::string& name, const std::vector<std::string>&
   std::vector<const char*> shown = {"articula", name.c_str()};
   for (const auto& a : args) shown.push_back(a.c_str());
   setCommandLine(static_cast<int>(shown.size()), shown.data());
+  const std::string outer_invoker = invokingCommand();
+  setInvokingCommand(outer_invoker.empty() ? outer : outer_invoker);
   const int rc = runSingle(static_cast<int>(full.size()), argv.data(), full[0], createCommand(name));
+  setInvokingCommand(outer_invoker);
   setCommandLineString(outer);
   return rc;
 }

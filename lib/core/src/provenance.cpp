@@ -34,7 +34,7 @@ class Sha256 {
   std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx_;
 };
 
-std::string g_command_line;
+std::string g_command_line, g_invoking_command;
 }  // namespace
 
 std::string sha256File(const std::filesystem::path& path) {
@@ -67,6 +67,8 @@ void setCommandLine(int argc, const char* const* argv) {
 
 std::string commandLine() { return g_command_line; }
 void setCommandLineString(const std::string& command) { g_command_line = command; }
+std::string invokingCommand() { return g_invoking_command; }
+void setInvokingCommand(const std::string& command) { g_invoking_command = command; }
 
 nlohmann::json provenanceJson(const Provenance& p) {
   nlohmann::json inputs = nlohmann::json::array();
@@ -84,6 +86,7 @@ nlohmann::json provenanceJson(const Provenance& p) {
                       {"coordinate_system", "LPS"},
                       {"units", "mm"}};
   if (p.seed >= 0) j["seed"] = p.seed;
+  if (!g_invoking_command.empty()) j["invoked_by"] = g_invoking_command;
   return j;
 }
 

@@ -722,7 +722,7 @@ const ModelFit& Summary::fit(ShapeModel model) const {
 
 std::string Summary::briefReport() const {
   std::ostringstream s;
-  s << "fitted " << fits.size() << " models to " << points << " points in " << seconds << " s; best: " << best_model;
+  s << "fitted " << fits.size() << " models to " << points << " points in " << seconds << " s; least RMS: " << best_model;
   return s.str();
 }
 
@@ -888,7 +888,7 @@ ModelFit fitFrom(const ShapeParameters& start, const Eigen::MatrixX3d& points, c
   const AlgebraicStarts a = algebraicStarts(points);
   const Bounds b = makeBounds(start.model, a.ellipsoid, a.sphere, o);
   Fitted f = fitModel(start.model, {{"given start", start, {}}}, b, points, o);
-  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet);
+  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty);
   return f.fit;
 }
 
@@ -931,7 +931,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   for (const Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid})
     if (wanted(o, f->fit.parameters.model) && f->fit.evaluations > 0) {
       summary.fits.push_back(f->fit);
-      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet);
+      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty);
     }
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)

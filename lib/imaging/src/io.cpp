@@ -321,13 +321,14 @@ void checkSlices(const std::vector<std::string>& files, const std::vector<DicomS
   spacing_out = std::fabs(median);
 }
 
-// Files of the folder in no series (no DICOM image): named in a warning,
-// and in the message when the series then lacks a slice.
+// Files of the folder in no series (no DICOM image): named in a warning
+// (the segmentation's summary keeps it), and in the message when the series
+// then lacks a slice.
 void noteUnreadableFiles(const fs::path& folder, const DicomFolder& scan, ReadReport& report) {
   report.unreadable_files = scan.other_files;
   if (!report.unreadable_files.empty())
-    log::warn(std::to_string(report.unreadable_files.size()) + " file(s) of " + folder.string() +
-              " are in no DICOM series (not DICOM, no image, or unreadable): " + unreadableList(report));
+    report.warnings.push_back(std::to_string(report.unreadable_files.size()) + " file(s) of " + folder.string() +
+                              " are in no DICOM series (not DICOM, no image, or unreadable): " + unreadableList(report));
 }
 
 DicomFolder scanSeries(const fs::path& folder);

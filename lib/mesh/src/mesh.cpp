@@ -47,12 +47,26 @@ std::string extensionOf(const fs::path& path) {
 /// The label, padded by one empty voxel on every side so that the surface
 /// closes where the label touches the grid's edge, with ITK's geometry: the
 /// direction matrix puts the mesh in physical LPS (flying edges honour it).
+// The label's set voxels within their bounding box, padded by one unset
+// voxel on every side (a closed surface where the label touches the grid's
+// edge): a clinical CT's grid is mostly far from the bone, and iso-surfacing
+// it whole costs its full size.
 vtkSmartPointer<vtkImageData> toVtk(const imaging::Label& label) {
   const imaging::ImageGeometry& g = label.geometry;
+  Eigen::Vector3i lo(g.size[0], g.size[1], g.size[2]), hi(-1, -1, -1);
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        if (label.at(i, j, k)) {
+          lo = lo.cwiseMin(Eigen::Vector3i(i, j, k));
+          hi = hi.cwiseMax(Eigen::Vector3i(i, j, k));
+        }
+  if (hi.x() < 0) lo = hi = Eigen::Vector3i::Zero();
+  const Eigen::Vector3i size = hi - lo + Eigen::Vector3i::Constant(3);
   auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(g.size[0] + 2, g.size[1] + 2, g.size[2] + 2);
+  image->SetDimensions(size[0], size[1], size[2]);
   image->SetSpacing(g.spacing[0], g.spacing[1], g.spacing[2]);
-  const Eigen::Vector3d origin = g.toPhysical(Eigen::Vector3d::Constant(-1.0));
+  const Eigen::Vector3d origin = g.toPhysical((lo - Eigen::Vector3i::Ones()).cast<double>());
   image->SetOrigin(origin[0], origin[1], origin[2]);
   double direction[9];
   for (int r = 0; r < 3; ++r)
@@ -60,11 +74,11 @@ vtkSmartPointer<vtkImageData> toVtk(const imaging::Label& label) {
   image->SetDirectionMatrix(direction);
   image->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
   auto* buffer = static_cast<unsigned char*>(image->GetScalarPointer());
-  std::fill(buffer, buffer + static_cast<long long>(g.size[0] + 2) * (g.size[1] + 2) * (g.size[2] + 2), 0);
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i)
-        buffer[(i + 1) + static_cast<long long>(g.size[0] + 2) * ((j + 1) + static_cast<long long>(g.size[1] + 2) * (k + 1))] =
+  std::fill(buffer, buffer + static_cast<long long>(size[0]) * size[1] * size[2], 0);
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i)
+        buffer[(i - lo[0] + 1) + static_cast<long long>(size[0]) * ((j - lo[1] + 1) + static_cast<long long>(size[1]) * (k - lo[2] + 1))] =
             label.at(i, j, k) ? 1 : 0;
   return image;
 }

@@ -14,6 +14,9 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
+#include "artefacts.hpp"
+#include "arthritis.hpp"
+#include "surface_search.hpp"
 
 namespace articula::phantom {
 namespace {
@@ -107,6 +110,13 @@ struct Anatomy {
   std::vector<Box> pelvis_blocks;     // sacrum and pubic symphysis (both hips)
   double socket_half_angle_cos = std::cos(80.0 * M_PI / 180.0);
   Vector3d wave_phase = Vector3d::Zero();
+  std::vector<Cyst> cysts;  // of the requested side's head
+  std::vector<Cylinder> metal;
+  std::optional<Cylinder> vessel;
+  /// The table's slab in the axial plane: radius to radius + thickness
+  /// from an axis along z through (x, y) = table_axis; air beyond.
+  std::optional<Eigen::Vector2d> table_axis;
+  double table_radius = 400.0, table_thickness = 6.0, table_hu = 700.0, air_hu = -1000.0;
   const PhantomOptions* o = nullptr;
 
   /// Depth inside a hip's acetabulum: a shell of the wall's thickness,
@@ -116,12 +126,20 @@ struct Anatomy {
     const Vector3d from_pole_centre = x - h.truth.socket_center;
     const double r = from_pole_centre.norm();
     const double cone = r * (from_pole_centre.dot(h.truth.socket_axis) / std::max(r, 1e-12) - socket_half_angle_cos);
-    if (o->congruent_socket) {
-      const double outside = -head_depth;
-      return std::min({outside - o->gap_mm, o->gap_mm + o->socket_wall_mm - outside, cone});
-    }
+    const double outside = -head_depth;
     const double inner = h.truth.socket_inner_radius_mm;
-    return std::min({r - inner, inner + o->socket_wall_mm - r, cone});
+    const double depth = o->congruent_socket ? std::min({outside - o->gap_mm, o->gap_mm + o->socket_wall_mm - outside, cone})
+                                             : std::min({r - inner, inner + o->socket_wall_mm - r, cone});
+    if (!h.truth.narrow_gap) return depth;
+    // A narrowed joint: the socket's inner surface advances from its own
+    // distance to the head to the narrow gap over the patch (its outer
+    // surface stays), smoothly back at the patch's edge.
+    const double w = h.truth.narrow_gap->weight(x - h.center);
+    if (w <= 0) return depth;
+    const double own_gap = o->congruent_socket ? o->gap_mm : outside + inner - r;
+    const double gap = own_gap - w * (own_gap - h.truth.narrow_gap->gap_mm);
+    const double outer = o->congruent_socket ? o->gap_mm + o->socket_wall_mm - outside : inner + o->socket_wall_mm - r;
+    return std::max(depth, std::min({outside - gap, outer, cone}));
   }
 
   /// Cancellous HU at x: uniform, or varying smoothly (wavelength 30 mm).
@@ -131,9 +149,43 @@ struct Anatomy {
     return base + o->cancellous_variation_hu * std::sin(w[0]) * std::sin(w[1]) * std::sin(w[2]);
   }
 
-  /// HU at x and the distance to the nearest tissue interface (mm); `femur`
-  /// gets the label of the femur containing x (0: none).
+  /// Depth inside the metal (positive inside, mm).
+  double metalDepth(const Vector3d& x) const {
+    double depth = -std::numeric_limits<double>::infinity();
+    for (const Cylinder& c : metal) depth = std::max(depth, c.depth(x));
+    return depth;
+  }
+
+  /// HU at x and the distance to the nearest interface: the tissues, with
+  /// what lies in them (metal).
   double hu(const Vector3d& x, double& interface, int* femur_label = nullptr) const {
+    bool in_bone = false;
+    const double tissue = tissueHu(x, interface, femur_label, &in_bone);
+    if (metal.empty() && !vessel && !table_axis) return tissue;
+    double value = tissue;
+    if (table_axis) {
+      // Posterior of the body's back: the table's slab, then air.
+      const double r = (x.head<2>() - *table_axis).norm();
+      interface = std::min({interface, std::fabs(r - table_radius), std::fabs(r - table_radius - table_thickness)});
+      if (r > table_radius + table_thickness) return air_hu;
+      if (r > table_radius) return table_hu;
+    }
+    if (vessel) {
+      const double depth = vessel->depth(x);
+      interface = std::min(interface, std::fabs(depth));
+      if (depth > 0 && !in_bone) value = o->vessel_hu;
+    }
+    if (!metal.empty()) {
+      const double depth = metalDepth(x);
+      interface = std::min(interface, std::fabs(depth));
+      if (depth > 0) value = o->metal_hu;
+    }
+    return value;
+  }
+
+  /// The tissues' HU at x and the distance to the nearest tissue interface
+  /// (mm); `femur` gets the label of the femur containing x (0: none).
+  double tissueHu(const Vector3d& x, double& interface, int* femur_label = nullptr, bool* in_bone = nullptr) const {
     double femur = -std::numeric_limits<double>::infinity(), pelvis = femur, clearance = -femur;
     for (size_t n = 0; n < hips.size(); ++n) {
       const HipAnatomy& h = hips[n];
@@ -152,40 +204,21 @@ struct Anatomy {
     const double cortex = o->cortical_mm;
     interface = std::min({std::fabs(femur), std::fabs(femur - cortex), std::fabs(pelvis), std::fabs(pelvis - cortex)});
     const double bone = std::max(femur, pelvis);
+    if (in_bone) *in_bone = bone > 0;
     if (bone <= 0) return o->soft_tissue_hu;
-    if (femur >= pelvis) return bone < cortex ? o->cortical_hu : cancellous(o->cancellous_hu, x);
+    if (femur >= pelvis) {
+      // Subchondral cysts: fluid balls in the cancellous bone.
+      for (const Cyst& cyst : cysts) {
+        const double depth = cyst.radius_mm - (x - cyst.center).norm();
+        interface = std::min(interface, std::fabs(depth));
+        if (depth > 0 && bone >= cortex) return o->cyst_hu;
+      }
+      return bone < cortex ? o->cortical_hu : cancellous(o->cancellous_hu, x);
+    }
     return bone < cortex ? o->socket_cortical_hu.value_or(o->cortical_hu)
                          : cancellous(o->socket_cancellous_hu.value_or(o->cancellous_hu), x);
   }
 };
-
-/// Separable Gaussian blur of an i-fastest buffer, sigma in mm per axis;
-/// hand-written so that this module stays free of ITK.
-void blur(imaging::Volume& v, double sigma_mm) {
-  const imaging::ImageGeometry& g = v.geometry;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double s = sigma_mm / g.spacing[axis];
-    if (s < 0.1) continue;
-    const int r = static_cast<int>(std::ceil(3 * s));
-    std::vector<double> w(static_cast<size_t>(2 * r + 1));
-    double sum = 0;
-    for (int t = -r; t <= r; ++t) sum += w[static_cast<size_t>(t + r)] = std::exp(-0.5 * t * t / (s * s));
-    for (double& x : w) x /= sum;
-    const long long stride = axis == 0 ? 1 : axis == 1 ? g.size[0] : static_cast<long long>(g.size[0]) * g.size[1];
-    const int n = g.size[axis];
-    std::vector<float> line(static_cast<size_t>(n));
-    for (long long start = 0; start < g.voxelCount(); ++start) {
-      // Visit each line once, from its first voxel.
-      if ((start / stride) % n != 0) continue;
-      for (int t = 0; t < n; ++t) line[static_cast<size_t>(t)] = v.voxels[static_cast<size_t>(start + t * stride)];
-      for (int t = 0; t < n; ++t) {
-        double acc = 0;
-        for (int q = -r; q <= r; ++q) acc += w[static_cast<size_t>(q + r)] * line[static_cast<size_t>(std::clamp(t + q, 0, n - 1))];
-        v.voxels[static_cast<size_t>(start + t * stride)] = static_cast<float>(acc);
-      }
-    }
-  }
-}
 
 nlohmann::json vec(const Vector3d& v) { return {v[0], v[1], v[2]}; }
 
@@ -263,6 +296,106 @@ HipAnatomy makeHip(const PhantomOptions& o, const geometry::ShapeParameters& p, 
   return h;
 }
 
+/// The tissues on grid g, each voxel the mean of 3 x 3 x 3 samples where an
+/// interface passes within half its diagonal (partial volume), and the femur
+/// label of its centre.
+void render(const Anatomy& a, const imaging::ImageGeometry& g, imaging::Volume& ct, imaging::Label& femur) {
+  ct.geometry = g;
+  ct.voxels.resize(static_cast<size_t>(g.voxelCount()));
+  femur.geometry = g;
+  femur.voxels.assign(ct.voxels.size(), 0);
+  const double half_diagonal = 0.5 * g.spacing.norm();
+  const int sub = 3;  // partial volume: 3 x 3 x 3 samples in voxels near an interface
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const Vector3d x = g.toPhysical(Vector3d(i, j, k));
+        double interface = 0;
+        int label = 0;
+        double value = a.hu(x, interface, &label);
+        if (interface < half_diagonal) {
+          value = 0;
+          double ignored = 0;
+          for (int c = 0; c < sub * sub * sub; ++c) {
+            const Vector3d offset((c % sub + 0.5) / sub - 0.5, (c / sub % sub + 0.5) / sub - 0.5, (c / (sub * sub) + 0.5) / sub - 0.5);
+            value += a.hu(g.toPhysical(Vector3d(i, j, k) + offset), ignored);
+          }
+          value /= sub * sub * sub;
+        }
+        ct.at(i, j, k) = static_cast<float>(value);
+        femur.at(i, j, k) = static_cast<std::uint8_t>(label);
+      }
+}
+
+/// Slices thicker than their spacing: the tissues rendered on slices m
+/// times finer (0.5 mm or a quarter of the thickness at most), each output
+/// slice their mean over a box `thickness` wide about it (the fine slices
+/// weighted by their overlap with the box); the label of its centre.
+void renderThickSlices(const Anatomy& a, const imaging::ImageGeometry& g, double thickness, imaging::Volume& ct,
+                       imaging::Label& femur) {
+  const int m = std::max(2, static_cast<int>(std::ceil(g.spacing[2] / std::min(0.5, 0.25 * thickness))));
+  const double fine_mm = g.spacing[2] / m, half = 0.5 * thickness / fine_mm;  // the box's half width in fine slices
+  const int pad = static_cast<int>(std::ceil(half)) + 1;
+  imaging::ImageGeometry fine = g;
+  fine.spacing[2] = fine_mm;
+  fine.size[2] = (g.size[2] - 1) * m + 1 + 2 * pad;
+  fine.origin = g.toPhysical(Vector3d(0, 0, -static_cast<double>(pad) / m));
+  imaging::Volume fine_ct;
+  imaging::Label fine_label;
+  render(a, fine, fine_ct, fine_label);
+  ct.geometry = g;
+  ct.voxels.assign(static_cast<size_t>(g.voxelCount()), 0.0f);
+  femur.geometry = g;
+  femur.voxels.assign(ct.voxels.size(), 0);
+  for (int k = 0; k < g.size[2]; ++k) {
+    const int centre = m * k + pad;
+    for (int q = -pad; q <= pad; ++q) {
+      const double w = std::max(0.0, std::min(q + 0.5, half) - std::max(q - 0.5, -half)) / (2.0 * half);
+      if (w <= 0) continue;
+      for (int j = 0; j < g.size[1]; ++j)
+        for (int i = 0; i < g.size[0]; ++i) ct.at(i, j, k) += static_cast<float>(w * fine_ct.at(i, j, centre + q));
+    }
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) femur.at(i, j, k) = fine_label.at(i, j, centre);
+  }
+}
+
+/// Where a clipped field of view ends: the voxel centres along index axis
+/// `axis` beyond `plane` (a coordinate along the face's direction u) go.
+struct FovCrop {
+  Vector3d u;
+  int axis = 2;
+  double plane = 0, head_extent = 0, r0 = 0;  // head_extent: the head's support coordinate along u
+};
+
+/// Plans the crop for the requested head and moves the grid along the face's
+/// axis (by under a voxel) so that a layer of voxel centres lies on the plane.
+FovCrop planFovCrop(const PhantomOptions& o, const HipAnatomy& h, imaging::ImageGeometry& g) {
+  FovCrop crop;
+  crop.u = o.fov_face;
+  crop.r0 = h.r0;
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(g.direction.col(a).dot(crop.u)) > 0.5) crop.axis = a;
+  const detail::Inside model = [&h](const Vector3d& x) { return h.head->value(x) < 0; };
+  crop.head_extent = detail::support(model, h.center, crop.u, 2.0 * h.rmax).dot(crop.u);
+  crop.plane = crop.head_extent - o.fov_cut * h.r0;
+  const double step = g.direction.col(crop.axis).dot(crop.u) * g.spacing[crop.axis];  // along u per index
+  const double from_origin = crop.plane - g.origin.dot(crop.u);
+  g.origin += (from_origin - step * std::round(from_origin / step)) * crop.u;
+  return crop;
+}
+
+/// The volume and the label with the voxels beyond the crop's plane removed.
+void applyFovCrop(const FovCrop& crop, Phantom& out) {
+  const imaging::ImageGeometry& g = out.ct.geometry;
+  const double step = g.direction.col(crop.axis).dot(crop.u) * g.spacing[crop.axis];
+  const int at = static_cast<int>(std::lround((crop.plane - g.origin.dot(crop.u)) / step));
+  const int last = g.size[crop.axis] - 1;
+  const int lo = step > 0 ? 0 : std::clamp(at, 0, last), hi = step > 0 ? std::clamp(at, 0, last) : last;
+  out.ct = detail::cropAxis(out.ct, crop.axis, lo, hi);
+  out.femur = detail::cropAxis(out.femur, crop.axis, lo, hi);
+}
+
 nlohmann::json hipTruth(const Hip& hip, const PhantomOptions& o) {
   const geometry::ShapeParameters& p = hip.head;
   nlohmann::json lambda;
@@ -290,15 +423,44 @@ nlohmann::json hipTruth(const Hip& hip, const PhantomOptions& o) {
   };
   if (hip.fovea)
     t["fovea"] = {{"center_mm", vec(hip.fovea_center)}, {"radius_mm", hip.fovea_radius_mm}, {"depth_mm", o.fovea_depth_mm}};
+  const nlohmann::json departures = detail::departuresJson(hip, o);
+  if (!departures.empty()) t["departures"] = departures;
   return t;
 }
+
+Vector3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
 
 }  // namespace
 
 double headSurfaceDistance(const Hip& hip, double head_distance_mm, const Eigen::Vector3d& x) {
-  if (!hip.fovea) return head_distance_mm;
+  double d = head_distance_mm;
   // The head less the pit's ball: max(d_head, -d_ball), exact away from the pit's rim.
-  return std::max(head_distance_mm, hip.fovea_radius_mm - (x - hip.fovea_center).norm());
+  if (hip.fovea) d = std::max(d, hip.fovea_radius_mm - (x - hip.fovea_center).norm());
+  // Less the half-space beyond a flattened dome's plane; with the lip added.
+  if (hip.flat_dome) d = std::max(d, (x - hip.flat_dome->point).dot(hip.flat_dome->normal));
+  if (hip.osteophytes) d = std::min(d, hip.osteophytes->distance(x));
+  return d;
+}
+
+Hip hipFromTruth(const nlohmann::json& t) {
+  Hip hip;
+  hip.right = t.at("side") == "right";
+  geometry::ShapeParameters& p = hip.head;
+  p.model = geometry::modelFromName(t.at("model").get<std::string>());
+  p.radii = vec3(t.at("radii_mm"));
+  p.exponents = vec3(t.at("exponents"));
+  for (int n = 0; n < 4; ++n) p.cx[n] = t.at("cx")[n].get<double>(), p.cy[n] = t.at("cy")[n].get<double>();
+  p.center = vec3(t.at("head_center_mm"));
+  p.angles = vec3(t.at("angles_rad"));
+  if (t.contains("neck_axis")) hip.neck_axis = vec3(t["neck_axis"]);
+  if (t.contains("socket_axis")) hip.socket_axis = vec3(t["socket_axis"]);
+  if (t.contains("fovea")) {
+    hip.fovea = true;
+    hip.fovea_center = vec3(t["fovea"]["center_mm"]);
+    hip.fovea_radius_mm = t["fovea"]["radius_mm"].get<double>();
+  }
+  if (t.contains("departures")) detail::departuresFromJson(t["departures"], hip);
+  return hip;
 }
 
 void PhantomOptions::makeOsteoporotic() {
@@ -323,6 +485,38 @@ void PhantomOptions::validate() const {
   if (!(socket_excess_mm >= 0 && socket_excess_mm <= 15)) throw UsageError("phantom --socket-excess: expected 0 to 15 mm");
   if (!(fovea_radius_mm > 0 && fovea_depth_mm > 0 && fovea_depth_mm < fovea_radius_mm && fovea_radius_mm <= 10))
     throw UsageError("phantom fovea: expected 0 < depth < radius <= 10 mm");
+  if (!(flattened_dome >= 0 && flattened_dome <= 0.5)) throw UsageError("phantom --flattened-dome: expected 0 to 0.5 of the radius");
+  if (!(osteophytes_mm >= 0 && osteophytes_mm <= 6)) throw UsageError("phantom --osteophytes: expected 0 to 6 mm");
+  if (!(narrow_gap_mm == 0 || (narrow_gap_mm >= 0.3 && narrow_gap_mm < gap_mm)))
+    throw UsageError("phantom --narrow-gap: expected 0.3 mm to less than the joint's --gap");
+  if (!(slice_thickness_mm >= 0 && slice_thickness_mm <= 10)) throw UsageError("phantom --slice-thickness: expected 0 to 10 mm");
+  if (fov_cut >= 0 && !(fov_cut <= 0.9)) throw UsageError("phantom --fov-cut: expected 0 to 0.9 of the radius");
+  if (fov_cut >= 0 && !(std::abs(fov_face.norm() - 1) < 1e-9 && fov_face.cwiseAbs().maxCoeff() > 1 - 1e-9))
+    throw UsageError("phantom --fov-face: expected a unit axis direction");
+}
+
+PhantomOptions::Metal metalFromName(const std::string& name) {
+  if (name == "none") return PhantomOptions::Metal::None;
+  if (name == "screw") return PhantomOptions::Metal::Screw;
+  if (name == "stem") return PhantomOptions::Metal::Stem;
+  throw UsageError("--metal '" + name + "': expected screw or stem");
+}
+
+PhantomOptions::Kernel kernelFromName(const std::string& name) {
+  if (name == "standard") return PhantomOptions::Kernel::Standard;
+  if (name == "soft") return PhantomOptions::Kernel::Soft;
+  if (name == "sharp") return PhantomOptions::Kernel::Sharp;
+  throw UsageError("--kernel '" + name + "': expected standard, soft or sharp");
+}
+
+Vector3d faceDirection(const std::string& face) {
+  static const std::vector<std::pair<std::string, Vector3d>> faces = {
+      {"+x", Vector3d::UnitX()}, {"-x", -Vector3d::UnitX()}, {"+y", Vector3d::UnitY()}, {"-y", -Vector3d::UnitY()},
+      {"+z", Vector3d::UnitZ()}, {"-z", -Vector3d::UnitZ()}, {"L", Vector3d::UnitX()},  {"R", -Vector3d::UnitX()},
+      {"P", Vector3d::UnitY()},  {"A", -Vector3d::UnitY()}, {"S", Vector3d::UnitZ()},  {"I", -Vector3d::UnitZ()}};
+  for (const auto& [name, u] : faces)
+    if (face == name) return u;
+  throw UsageError("--fov-face '" + face + "': expected +x, -x, +y, -y, +z, -z (or L, R, P, A, S, I)");
 }
 
 Phantom makePhantom(const PhantomOptions& o) {
@@ -343,6 +537,27 @@ Phantom makePhantom(const PhantomOptions& o) {
     double r0 = 0;
     const geometry::ShapeParameters head = drawHead(o, model, sides[n] ? -1.0 : 1.0, uniform, r0);
     a.hips.push_back(makeHip(o, head, r0, sides[n]));
+  }
+  HipAnatomy& requested = a.hips[0];
+  detail::addArthritis(o, *requested.head, requested.r0, requested.neck_radius, requested.truth);
+  a.cysts = requested.truth.cysts;
+  if (o.metal == PhantomOptions::Metal::Screw) {
+    // A lag screw along the neck from beyond the lateral cortex to 6 mm under the dome.
+    const Vector3d axis = requested.truth.neck_axis;
+    const detail::Inside model = [&requested](const Vector3d& x) { return requested.head->value(x) < 0; };
+    const double to_dome = detail::along(model, requested.center, -axis, 2.0 * requested.rmax);
+    a.metal.push_back({requested.center - (to_dome - 6.0) * axis, requested.center + (1.9 * requested.r0 + 30.0) * axis, 3.25});
+  } else if (o.metal == PhantomOptions::Metal::Stem) {
+    a.metal.push_back({requested.shaft_top + Vector3d(0, 0, 5.0), requested.shaft_top - Vector3d(0, 0, 140.0), 6.0});
+  }
+  if (o.contrast_vessel) {
+    // Anterior (LPS -y) and a little medial of the head, its wall 5 mm off
+    // the bounding sphere, running down and a little laterally.
+    const double s = requested.truth.right ? -1.0 : 1.0, radius = 3.0;
+    const Vector3d offset = Vector3d(-s * 0.35, -1.0, 0.0).normalized() * (requested.rmax + 5.0 + radius);
+    const Vector3d along = Vector3d(-s * 0.15, 0.0, 1.0).normalized();
+    const Vector3d at = requested.center + offset;
+    a.vessel = Cylinder{at - 400.0 * along, at + 400.0 * along, radius};
   }
   if (o.cancellous_variation_hu > 0) a.wave_phase = Vector3d(uniform(0, 2 * M_PI), uniform(0, 2 * M_PI), uniform(0, 2 * M_PI));
 
@@ -373,6 +588,12 @@ Phantom makePhantom(const PhantomOptions& o) {
     }
     hi[1] = std::max(hi[1], mid[1] + 82.0);
   }
+  if (o.table) {
+    // The table's trough 5 mm beyond the field's back, under the body's
+    // middle (x = 0), rising towards the sides; the grid holds it and 15 mm of air.
+    a.table_axis = Eigen::Vector2d(0.0, hi[1] + 5.0 - a.table_radius);
+    hi[1] += 5.0 + a.table_thickness + 15.0;
+  }
   imaging::ImageGeometry g;
   g.spacing = o.spacing;
   for (int ax = 0; ax < 3; ++ax) g.size[ax] = static_cast<int>(std::ceil((hi[ax] - lo[ax]) / o.spacing[ax])) + 1;
@@ -383,40 +604,29 @@ Phantom makePhantom(const PhantomOptions& o) {
   } else {
     g.origin = lo;
   }
+  std::optional<FovCrop> crop;
+  if (o.fov_cut >= 0) crop = planFovCrop(o, a.hips[0], g);
 
   Phantom out;
   for (const HipAnatomy& h : a.hips) out.hips.push_back(h.truth);
   out.head = out.hips[0].head;
   out.neck_axis = out.hips[0].neck_axis;
-  out.ct.geometry = g;
-  out.ct.voxels.resize(static_cast<size_t>(g.voxelCount()));
-  out.femur.geometry = g;
-  out.femur.voxels.assign(out.ct.voxels.size(), 0);
-  const double half_diagonal = 0.5 * o.spacing.norm();
-  const int sub = 3;  // partial volume: 3 x 3 x 3 samples in voxels near an interface
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i) {
-        const Vector3d x = g.toPhysical(Vector3d(i, j, k));
-        double interface = 0;
-        int label = 0;
-        double value = a.hu(x, interface, &label);
-        if (interface < half_diagonal) {
-          value = 0;
-          double ignored = 0;
-          for (int c = 0; c < sub * sub * sub; ++c) {
-            const Vector3d offset((c % sub + 0.5) / sub - 0.5, (c / sub % sub + 0.5) / sub - 0.5, (c / (sub * sub) + 0.5) / sub - 0.5);
-            value += a.hu(g.toPhysical(Vector3d(i, j, k) + offset), ignored);
-          }
-          value /= sub * sub * sub;
-        }
-        out.ct.at(i, j, k) = static_cast<float>(value);
-        out.femur.at(i, j, k) = static_cast<std::uint8_t>(label);
-      }
-  blur(out.ct, o.blur_mm);
+  if (o.slice_thickness_mm > g.spacing[2]) {
+    renderThickSlices(a, g, o.slice_thickness_mm, out.ct, out.femur);
+  } else {
+    render(a, g, out.ct, out.femur);
+  }
+  detail::blur(out.ct, Vector3d::Constant(o.blur_mm));
+  if (!a.metal.empty())
+    detail::addMetalStreaks(out.ct, [&a](const Vector3d& x) { return a.metalDepth(x) > 0; }, o.seed ^ 0x3e7a1c5ULL);
   std::normal_distribution<double> noise(0.0, o.noise_hu);
   if (o.noise_hu > 0)
     for (float& v : out.ct.voxels) v += static_cast<float>(noise(rng));
+  // The kernel filters the tissues and their noise together, within the slices.
+  if (o.kernel == PhantomOptions::Kernel::Soft) detail::blur(out.ct, Vector3d(0.6, 0.6, 0.0));
+  if (o.kernel == PhantomOptions::Kernel::Sharp) detail::sharpenInPlane(out.ct, 0.8, 1.0);
+  if (!a.metal.empty() || a.table_axis) detail::clipToScannerRange(out.ct);
+  if (crop) applyFovCrop(*crop, out);
 
   // Top level: the requested side's head, as in the single-hip phantom; `hips`: every head.
   out.truth = hipTruth(out.hips[0], o);
@@ -440,13 +650,44 @@ Phantom makePhantom(const PhantomOptions& o) {
       {"noise_hu", o.noise_hu},
       {"blur_mm", o.blur_mm},
       {"grid",
-       {{"size", {g.size[0], g.size[1], g.size[2]}},
+       {{"size", {out.ct.geometry.size[0], out.ct.geometry.size[1], out.ct.geometry.size[2]}},
         {"spacing_mm", vec(g.spacing)},
-        {"origin_mm", vec(g.origin)},
+        {"origin_mm", vec(out.ct.geometry.origin)},
         {"direction_row_major",
          {g.direction(0, 0), g.direction(0, 1), g.direction(0, 2), g.direction(1, 0), g.direction(1, 1),
           g.direction(1, 2), g.direction(2, 0), g.direction(2, 1), g.direction(2, 2)}}}},
   });
+  if (!a.metal.empty()) {
+    const Cylinder& m = a.metal.front();
+    out.truth["metal"] = {{"kind", o.metal == PhantomOptions::Metal::Screw ? "screw" : "stem"},
+                          {"from_mm", vec(m.a)},
+                          {"to_mm", vec(m.b)},
+                          {"radius_mm", m.radius},
+                          {"hu", o.metal_hu},
+                          {"clipped_to_hu", {-1024, 3071}}};
+  }
+  if (o.kernel != PhantomOptions::Kernel::Standard) out.truth["kernel"] = o.kernel == PhantomOptions::Kernel::Soft ? "soft" : "sharp";
+  if (o.slice_thickness_mm > g.spacing[2]) out.truth["slice_thickness_mm"] = o.slice_thickness_mm;
+  if (a.vessel)
+    out.truth["contrast_vessel"] = {{"point_mm", vec(0.5 * (a.vessel->a + a.vessel->b))},
+                                    {"direction", vec((a.vessel->b - a.vessel->a).normalized())},
+                                    {"radius_mm", a.vessel->radius},
+                                    {"hu", o.vessel_hu}};
+  if (a.table_axis)
+    out.truth["table"] = {{"axis_xy_mm", {(*a.table_axis)[0], (*a.table_axis)[1]}},
+                          {"radius_mm", a.table_radius},
+                          {"thickness_mm", a.table_thickness},
+                          {"hu", a.table_hu},
+                          {"air_hu", a.air_hu}};
+  if (crop) {
+    const double beyond = crop->head_extent - crop->plane;
+    out.truth["fov_cut"] = {{"face", vec(crop->u)},
+                            {"fraction_of_radius", beyond / crop->r0},
+                            {"head_beyond_mm", beyond},
+                            {"radius_mm", crop->r0},
+                            {"plane_mm", crop->plane},
+                            {"head_extent_mm", crop->head_extent}};
+  }
   return out;
 }
 

@@ -11,29 +11,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The triangles with a corner within `radius` of `centre`, re-indexed: the
-// head and the start of its neck, not a whole femur, keep the page small.
+// The triangles with a corner within `radius` of `centre`: the head and the
+// start of its neck, not a whole femur, keep the page small.
 report::ViewSurface boneNear(const points::MeshFile& mesh, const Eigen::Vector3d& centre, double radius) {
-  std::vector<int> new_index(static_cast<size_t>(mesh.vertices.rows()), -1);
-  std::vector<Eigen::Vector3i> kept;
-  int n_vertices = 0;
-  for (Eigen::Index f = 0; f < mesh.triangles.rows(); ++f) {
+  return meshPart(mesh, "bone", [&](Eigen::Index f) {
     bool near = false;
     for (int k = 0; k < 3; ++k) near = near || (mesh.vertices.row(mesh.triangles(f, k)).transpose() - centre).norm() <= radius;
-    if (!near) continue;
-    Eigen::Vector3i t;
-    for (int k = 0; k < 3; ++k) {
-      int& index = new_index[static_cast<size_t>(mesh.triangles(f, k))];
-      if (index < 0) index = n_vertices++;
-      t[k] = index;
-    }
-    kept.push_back(t);
-  }
-  report::ViewSurface bone{"bone", Eigen::MatrixX3d(n_vertices, 3), Eigen::MatrixX3i(static_cast<Eigen::Index>(kept.size()), 3)};
-  for (size_t v = 0; v < new_index.size(); ++v)
-    if (new_index[v] >= 0) bone.vertices.row(new_index[v]) = mesh.vertices.row(static_cast<Eigen::Index>(v));
-  for (size_t f = 0; f < kept.size(); ++f) bone.triangles.row(static_cast<Eigen::Index>(f)) = kept[f].transpose();
-  return bone;
+    return near;
+  });
 }
 
 double cell(const CsvTable& table, size_t row, int column, const fs::path& path) {
@@ -45,6 +30,28 @@ double cell(const CsvTable& table, size_t row, int column, const fs::path& path)
 }
 
 }  // namespace
+
+report::ViewSurface meshPart(const points::MeshFile& mesh, const std::string& name,
+                             const std::function<bool(Eigen::Index)>& keep) {
+  std::vector<int> new_index(static_cast<size_t>(mesh.vertices.rows()), -1);
+  std::vector<Eigen::Vector3i> kept;
+  int n_vertices = 0;
+  for (Eigen::Index f = 0; f < mesh.triangles.rows(); ++f) {
+    if (!keep(f)) continue;
+    Eigen::Vector3i t;
+    for (int k = 0; k < 3; ++k) {
+      int& index = new_index[static_cast<size_t>(mesh.triangles(f, k))];
+      if (index < 0) index = n_vertices++;
+      t[k] = index;
+    }
+    kept.push_back(t);
+  }
+  report::ViewSurface part{name, Eigen::MatrixX3d(n_vertices, 3), Eigen::MatrixX3i(static_cast<Eigen::Index>(kept.size()), 3)};
+  for (size_t v = 0; v < new_index.size(); ++v)
+    if (new_index[v] >= 0) part.vertices.row(new_index[v]) = mesh.vertices.row(static_cast<Eigen::Index>(v));
+  for (size_t f = 0; f < kept.size(); ++f) part.triangles.row(static_cast<Eigen::Index>(f)) = kept[f].transpose();
+  return part;
+}
 
 report::View3d loadHeadView(const fs::path& folder, const std::vector<geometry::ShapeParameters>& shapes,
                             const std::string& selected_model) {

@@ -26,8 +26,10 @@ constexpr double kInsideWarn = 0.15, kInsideFail = 0.30;      // share of the po
 // The cortex's contrast across the slices relative to within them: 0.38-1.05
 // on the correct heads of two phantom generators (1.5 x 1.5 x 3 mm voxels
 // included); 0.06-0.26 where a thin cortex under 1.5-2.5 mm of blur across
-// 2-3 mm slices put the surface 0.36-0.79 mm outside on average.
-constexpr double kSliceContrastWarn = 0.3;
+// 2-3 mm slices put the surface 0.36-0.79 mm outside on average; 0.30 where
+// 4 mm thick slices (every 2 mm) put it 0.31 mm outside, beyond half the
+// 0.7 mm voxel (the clinical matrix), and 0.35 at 1 mm voxels, 0.30 mm out.
+constexpr double kSliceContrastWarn = 0.35;
 constexpr double kSliceAxisShare = 0.8, kInPlaneShare = 0.3;  // |normal . slice axis| of the two groups of lines
 constexpr int kMinLinesPerGroup = 20;
 constexpr double kMinInPlaneContrastHu = 100;
@@ -57,7 +59,22 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // Metal near the head: voxels above 2,500 HU (cortical bone reaches about
 // 2,000) within two radii of its centre, warned from 100 mm^3 (a screw of
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
-constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;                              // warnings of the structure's checks
+constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
+// The bone departs from the selected model over its cap (cap_departures.hpp):
+// the largest region beyond the threshold and 2 mm deep, a hip's fovea
+// aside. Warned from 40 mm^2: a dome flattened by a tenth of a 20 mm radius
+// departs over about 125 mm^2 (on phantoms 230-320 mm^2 at 10-15 %), a 3 mm
+// lip over 50-90 mm^2.
+constexpr double kDepartureWarnMm2 = 40;
+// The fitted sphere beyond the field of view on its farthest side, relative
+// to the radius. On the clinical matrix (bench/clinical.sh: 6 heads, each
+// face cut 0, 10, 25 and 50 % of the radius into the head): 0-0.09 at a
+// tangent, 0.06-0.19 at 10 %, 0.20-0.34 at 25 %, 0.41-0.59 at 50 % (a head's
+// extent along a face and its fitted sphere's differ by up to 6 %); 0 on
+// every uncut CT. Warned above 0.03: every cut of a tenth of the radius, on
+// the neck's side too, where the share above (its cone about the neck left
+// out) stayed at 0.00-0.08.
+constexpr double kBeyondFovWarn = 0.03;
 
 // A yes-or-no check of how the head was found: 1 passes, 0 warns; no doubt
 // about the structure either way.
@@ -248,6 +265,18 @@ double metalNearHead(const imaging::Volume& ct, const Eigen::Vector3d& center, d
   return static_cast<double>(metal) * g.spacing.prod();
 }
 
+double headBeyondFieldOfView(const imaging::ImageGeometry& grid, const Eigen::Vector3d& center, double radius_mm) {
+  // The grid's axes are orthonormal: the sphere spans radius / spacing
+  // indices either way along each, about its centre's index.
+  const Eigen::Vector3d c = grid.toIndex(center);
+  double beyond = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double reach = radius_mm / grid.spacing[a];
+    beyond = std::max({beyond, (c[a] + reach - (grid.size[a] - 1)) * grid.spacing[a], (reach - c[a]) * grid.spacing[a]});
+  }
+  return beyond;
+}
+
 QcReport checkHead(const HeadQcInput& in) {
   const Eigen::Index n = in.points.rows();
   if (n < 4) throw InputError("head checks need at least 4 points, found " + std::to_string(n));
@@ -355,6 +384,33 @@ QcReport checkHead(const HeadQcInput& in) {
       metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
     report.checks.push_back(metal);
   }
+  if (in.cap_departure_mm2) {
+    // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
+    QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
+                            "the bone departs from the selected model over part of its cap: the largest region "
+                            "departing by 2 mm or more (mm^2, a hip's fovea aside) is");
+    departs.of_structure = false;
+    if (departs.status == "warn")
+      departs.reason += ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone "
+                        "taken in, a slice too many at coarse slices), or a head no model of the hierarchy follows there; "
+                        "the model describes the rest (see cap_departures in results.json and the slices)";
+    report.checks.push_back(departs);
+  }
+  if (in.surface_on_ct_edges)
+    report.checks.push_back(flag("surface_on_ct_edges", *in.surface_on_ct_edges,
+                                 "warn when the surface could not be moved onto the CT's bone edges",
+                                 "too few of the surface's vertices found a bone edge in the CT (coarse or lossy voxels, "
+                                 "or not the CT the label was made from): the surface is the label's voxel staircase, "
+                                 "up to half a voxel off the bone"));
+  {
+    // Every warning of a stage is a named check, never a terminal line only.
+    std::string joined;
+    for (const auto& w : in.stage_warnings) joined += (joined.empty() ? "" : "; ") + w;
+    QcCheck warned = flag("stage_warnings", in.stage_warnings.empty(), "warn when a stage warned (0: none)",
+                          "the stages warned: " + joined);
+    warned.value = static_cast<double>(in.stage_warnings.size());
+    report.checks.push_back(warned);
+  }
   if (in.body_middle_x_mm && (in.joint == "hip" || in.joint == "shoulder")) {
     // Femoral heads lie 60-110 mm from the body's middle (half the distance
     // between them), humeral heads 120-190 mm (the glenoids on either side
@@ -393,6 +449,18 @@ QcReport checkHead(const HeadQcInput& in) {
              "warn when neither the body's middle, a field of view holding both sides, nor the socket tells the side",
              "the joint's side could not be verified (a narrow field of view without the body's outline, and no "
              "socket clearly medial to the head): the joint in view was taken as the requested side"));
+  if (in.head_beyond_fov_mm) {
+    // Of what the data covers, not of the structure (as the share above).
+    QcCheck beyond = grade("head_beyond_fov_relative", *in.head_beyond_fov_mm / r, kBeyondFovWarn, std::nullopt, false,
+                           "the field of view ends inside the head's sphere: it reaches beyond the CT's last voxels, "
+                           "relative to its radius, by");
+    beyond.of_structure = false;
+    if (beyond.status == "warn")
+      beyond.reason += " (" + number(*in.head_beyond_fov_mm) +
+                       " mm; on the neck's side too): the points cover only the part in view, and the fitted shape "
+                       "extrapolates the rest";
+    report.checks.push_back(beyond);
+  }
   // Doubts compound: two checks of the structure that each find the head
   // doubtful are two independent signs of a wrong structure (on the phantom matrix, the one
   // head with two warnings had taken part of its socket; no correct head

@@ -4,7 +4,12 @@
 #include <cmath>
 #include <numeric>
 
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/special_functions/beta.hpp>
+
 #include "articula/core/error.hpp"
+#include "articula/geometry/shape.hpp"
 
 namespace articula::pipeline {
 
@@ -86,27 +91,103 @@ WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vecto
 double aic(double sse, int n, int k) { return n * std::log(sse / n) + 2.0 * k; }
 double bic(double sse, int n, int k) { return n * std::log(sse / n) + k * std::log(static_cast<double>(n)); }
 
-ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance,
-                                  double absolute_tolerance_mm) {
+NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer, double alpha) {
+  NestedStep step;
+  step.simpler = simpler.model;
+  step.richer = richer.model;
+  step.alpha = alpha;
+  const int n = richer.n_points;
+  step.df1 = richer.n_parameters - simpler.n_parameters;
+  step.df2 = n - richer.n_parameters;
+  // Each model's residuals misjudge the noise in one direction: the
+  // simpler model's hold the richer model's gain as if it were correlated
+  // noise (n_eff too low where the richer model is right), the richer
+  // model's have absorbed part of the noise (n_eff too high where the
+  // simpler one is right). Their geometric mean is used.
+  const double n_simpler = std::isfinite(simpler.n_eff) ? std::min(simpler.n_eff, static_cast<double>(n)) : n;
+  const double n_richer = std::isfinite(richer.n_eff) ? std::min(richer.n_eff, static_cast<double>(n)) : n;
+  step.n_eff = std::sqrt(n_simpler * n_richer);
+  if (step.df1 <= 0 || step.df2 <= 0 || !(richer.sse_mm2 > 0) || !std::isfinite(simpler.sse_mm2)) return step;
+  // The hierarchy keeps SSE_r <= SSE_s; a hair above from rounding is no fall.
+  const double fall = std::max(0.0, simpler.sse_mm2 - richer.sse_mm2);
+  step.f = (fall / step.df1) / (richer.sse_mm2 / step.df2) * step.n_eff / n;
+  step.p_value = boost::math::cdf(boost::math::complement(boost::math::fisher_f(step.df1, step.df2), step.f));
+  step.richer_needed = step.p_value < alpha;
+  return step;
+}
+
+ModelSelection selectNested(const std::vector<ModelEvidence>& models, double alpha) {
   ModelSelection out;
-  const bool any_determined =
-      std::any_of(scores.begin(), scores.end(), [](const ModelScore& s) { return s.determined && std::isfinite(s.rms_mm); });
-  auto candidate = [&](const ModelScore& s) { return std::isfinite(s.rms_mm) && (s.determined || !any_determined); };
-  double least = INFINITY;
-  for (const auto& s : scores) {
-    if (!s.determined) out.undetermined.push_back(s.model);
-    if (candidate(s)) least = std::min(least, s.rms_mm);
+  const auto named = [&models](const std::string& name) -> const ModelEvidence* {
+    for (const auto& m : models)
+      if (m.model == name) return &m;
+    return nullptr;
+  };
+  const bool any_determined = std::any_of(models.begin(), models.end(), [](const ModelEvidence& m) {
+    return m.determined && std::isfinite(m.sse_mm2);
+  });
+  for (const auto& m : models)
+    if (!m.determined) out.undetermined.push_back(m.model);
+  const auto candidate = [&](const ModelEvidence& m) { return std::isfinite(m.sse_mm2) && (m.determined || !any_determined); };
+  const auto contains = [](const std::string& general, const std::string& special) {
+    try {
+      return geometry::contains(geometry::modelFromName(general), geometry::modelFromName(special));
+    } catch (const Error&) {
+      return general == special;
+    }
+  };
+  for (const auto& [s, r] : std::vector<std::pair<const char*, const char*>>{{"sphere", "ellipsoid"},
+                                                                            {"ellipsoid", "superellipsoid"},
+                                                                            {"ellipsoid", "ovoid"},
+                                                                            {"superellipsoid", "superovoid"},
+                                                                            {"ovoid", "superovoid"}})
+    if (named(s) && named(r)) out.steps.push_back(nestedFTest(*named(s), *named(r), alpha));
+  // Start at the simplest candidate; walk while a richer one passes.
+  const ModelEvidence* current = nullptr;
+  for (const auto& m : models)
+    if (candidate(m) && (!current || m.n_parameters < current->n_parameters)) current = &m;
+  if (!current) return out;
+  while (true) {
+    std::vector<const ModelEvidence*> richer;
+    for (const auto& m : models)
+      if (candidate(m) && m.model != current->model && m.n_parameters > current->n_parameters &&
+          contains(m.model, current->model))
+        richer.push_back(&m);
+    if (richer.empty()) break;
+    const ModelEvidence* next = nullptr;
+    double next_p = INFINITY;
+    for (const ModelEvidence* m : richer) {
+      const NestedStep step = nestedFTest(*current, *m, alpha / static_cast<double>(richer.size()));
+      out.path.push_back(step);
+      if (step.richer_needed &&
+          (!next || m->n_parameters < next->n_parameters || (m->n_parameters == next->n_parameters && step.p_value < next_p))) {
+        next = m;
+        next_p = step.p_value;
+      }
+    }
+    if (!next) break;
+    current = next;
   }
-  if (!std::isfinite(least)) return out;
-  const ModelScore* chosen = nullptr;
-  for (const auto& s : scores) {
-    if (!candidate(s) || !(s.rms_mm <= least + std::max(relative_tolerance * least, absolute_tolerance_mm))) continue;
-    out.indistinguishable.push_back(s.model);
-    if (!chosen || s.n_parameters < chosen->n_parameters ||
-        (s.n_parameters == chosen->n_parameters && s.rms_mm < chosen->rms_mm))
-      chosen = &s;
+  out.selected = current->model;
+  return out;
+}
+
+CohortStep cohortStep(const std::vector<double>& p_values, const std::vector<bool>& richer_needed) {
+  CohortStep out;
+  double sum = 0;
+  int k = 0;
+  for (double p : p_values)
+    if (std::isfinite(p)) {
+      sum += -2.0 * std::log(std::max(p, 1e-300));
+      ++k;
+    }
+  if (k > 0) out.fisher_p = boost::math::cdf(boost::math::complement(boost::math::chi_squared(2.0 * k), sum));
+  out.subjects = static_cast<int>(richer_needed.size());
+  out.richer_needed = static_cast<int>(std::count(richer_needed.begin(), richer_needed.end(), true));
+  if (out.subjects > 0) {
+    // P(X >= x), X ~ Bin(k, 1/2); ibeta gives the binomial tail exactly.
+    out.sign_test_p = out.richer_needed == 0 ? 1.0 : boost::math::ibeta(out.richer_needed, out.subjects - out.richer_needed + 1, 0.5);
   }
-  out.selected = chosen->model;
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/csv.hpp"
+#include "articula/pipeline/ratings.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/study_html.hpp"
 #include "articula/report/study_svg.hpp"
@@ -37,11 +38,31 @@ const std::vector<std::string> kErrorColumns = {"n_points",    "rms_mm",     "mi
 struct ModelRow {
   std::string subject, model;
   nlohmann::json entry;  // the model's entry of results.json
-  bool best = false;
+  bool best = false;  // the least RMS
   bool selected = false;  // results.json's selected_model
   std::string qc_status, qc_reasons;  // results.json's qc (the subject's)
   bool determined = true;  // not in results.json's selection.undetermined
+  nlohmann::json step;     // results.json's selection step into this model (null for the sphere)
 };
+
+// The hierarchy's step into `model` among a subject's selection.steps: the
+// superovoid's from its parent of the lower SSE, as results.csv has it.
+nlohmann::json stepInto(const nlohmann::json& results, const std::string& model) {
+  nlohmann::json chosen;
+  double chosen_sse = INFINITY;
+  const auto sse = [&results](const std::string& name) {
+    for (const auto& m : results.at("models"))
+      if (m.value("model", "") == name && m.contains("errors")) return m.at("errors").value("sse_mm2", static_cast<double>(INFINITY));
+    return static_cast<double>(INFINITY);
+  };
+  if (!results.contains("selection") || !results.at("selection").is_object()) return chosen;
+  for (const auto& st : results.at("selection").value("steps", nlohmann::json::array()))
+    if (st.value("richer", "") == model && sse(st.value("simpler", "")) < chosen_sse) {
+      chosen = st;
+      chosen_sse = sse(st.value("simpler", ""));
+    }
+  return chosen;
+}
 
 // study.svg: RMS per model, subject by subject (subjects in manifest order).
 std::string studyFigure(const std::vector<ModelRow>& rows, const std::vector<std::string>& model_order,
@@ -70,13 +91,18 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   std::vector<ModelRow> rows;
   std::vector<std::string> parameter_columns;  // union, in order of first appearance
   std::vector<std::string> model_order;
-  std::vector<std::pair<std::string, nlohmann::json>> finished;  // results.json of each finished subject
+  std::vector<std::pair<std::string, nlohmann::json>> finished;  // results.json of each finished subject kept
+  const std::map<std::string, Rating> ratings = readRatings(study_dir, subjects);
+  const auto excluded = [&ratings](const std::string& id) {
+    const auto it = ratings.find(id);
+    return it != ratings.end() && it->second.decision == "exclude";
+  };
   for (size_t i = 0; i < subjects.size(); ++i) {
-    if (batch.outcomes[i].status != "ok") continue;
+    if (batch.outcomes[i].status != "ok" || excluded(subjects[i].id)) continue;
     const fs::path path = subjectDir(study_dir, subjects[i].id) / "results.json";
     const nlohmann::json& results =
         finished.emplace_back(subjects[i].id, readJsonFile(path, "study (" + subjects[i].id + ")")).second;
-    const std::string best = results.value("best_model", ""), selected = results.value("selected_model", "");
+    const std::string best = results.value("least_rms_model", ""), selected = results.value("selected_model", "");
     std::string qc_status, qc_reasons;
     if (results.contains("qc") && results.at("qc").is_object()) {
       qc_status = results.at("qc").value("status", "");
@@ -89,8 +115,9 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
             : nlohmann::json::array();
     for (const auto& m : results.at("models")) {
       ModelRow row{subjects[i].id, m.at("model").get<std::string>(), m, m.at("model") == best, m.at("model") == selected,
-                   qc_status, qc_reasons};
+                   qc_status, qc_reasons, true, nlohmann::json()};
       row.determined = std::find(undetermined.begin(), undetermined.end(), m.at("model")) == undetermined.end();
+      row.step = stepInto(results, row.model);
       for (const auto& [key, value] : m.at("parameters").items())
         if (std::find(parameter_columns.begin(), parameter_columns.end(), key) == parameter_columns.end())
           parameter_columns.push_back(key);
@@ -103,8 +130,9 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   // study.csv
   std::vector<std::string> header = {"subject", "model", "n_parameters"};
   header.insert(header.end(), kErrorColumns.begin(), kErrorColumns.end());
-  header.insert(header.end(), {"aic", "bic", "best_by_rms", "selected", "determined", "qc_status", "qc_reasons",
-                               "semi_axis_a_mm", "semi_axis_b_mm", "semi_axis_c_mm"});
+  header.insert(header.end(), {"aic", "bic", "least_rms", "selected", "determined", "qc_status", "qc_reasons",
+                               "semi_axis_a_mm", "semi_axis_b_mm", "semi_axis_c_mm", "n_eff", "step_from", "step_f",
+                               "step_p_value", "richer_needed"});
   header.insert(header.end(), parameter_columns.begin(), parameter_columns.end());
   for (const auto& c : parameter_columns) header.push_back(c + "_se");  // standard errors, same units
   std::string study_csv = csvLine(header) + "\n";
@@ -120,6 +148,13 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     f.push_back(r.qc_reasons);
     const nlohmann::json axes = r.entry.value("semi_axes_mm", nlohmann::json::array());
     for (size_t k = 0; k < 3; ++k) f.push_back(k < axes.size() && axes[k].is_number() ? number(axes[k].get<double>()) : "");
+    const nlohmann::json correlation = r.entry.value("residual_correlation", nlohmann::json::object());
+    f.push_back(number(correlation.value("n_eff", NAN)));
+    const bool stepped = r.step.is_object();
+    f.push_back(stepped ? r.step.value("simpler", "") : "");
+    f.push_back(stepped && r.step.value("f", nlohmann::json()).is_number() ? number(r.step.at("f").get<double>()) : "");
+    f.push_back(stepped && r.step.value("p_value", nlohmann::json()).is_number() ? number(r.step.at("p_value").get<double>()) : "");
+    f.push_back(stepped ? (r.step.value("richer_needed", false) ? "1" : "0") : "");
     for (const auto& c : parameter_columns)
       f.push_back(r.entry.at("parameters").contains(c) ? number(r.entry.at("parameters").at(c).get<double>()) : "");
     const nlohmann::json se = r.entry.value("standard_errors", nlohmann::json::object());
@@ -145,7 +180,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   }
 
   nlohmann::json summary_json = nlohmann::json::array();
-  std::string summary_csv = csvLine({"model", "n_subjects", "rms_mean_mm", "rms_sd_mm", "times_selected", "times_best_by_rms",
+  std::string summary_csv = csvLine({"model", "n_subjects", "rms_mean_mm", "rms_sd_mm", "times_selected", "times_least_rms",
                                      "times_best_by_aic", "times_best_by_bic", "mean_delta_aic_vs_sphere",
                                      "mean_delta_bic_vs_sphere", "wilcoxon_n_vs_sphere", "wilcoxon_p_vs_sphere"}) +
                             "\n";
@@ -184,7 +219,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
                             {"rms_mean_mm", s.mean},
                             {"rms_sd_mm", s.sd},
                             {"times_selected", times_selected[model]},
-                            {"times_best_by_rms", best_rms[model]},
+                            {"times_least_rms", best_rms[model]},
                             {"times_best_by_aic", best_aic[model]},
                             {"times_best_by_bic", best_bic[model]}};
     if (paired)
@@ -192,22 +227,65 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
     summary_json.push_back(entry);
   }
 
-  std::string status_csv = csvLine({"subject", "status", "exit_code", "seconds", "message"}) + "\n";
+  // Per step of the hierarchy: how many subjects need the richer model, and
+  // the cohort's tests over the subjects' own (statistics.hpp, cohortStep).
+  nlohmann::json steps_json = nlohmann::json::array();
+  std::string steps_csv = csvLine({"simpler", "richer", "subjects", "richer_needed", "fisher_p", "sign_test_p"}) + "\n";
+  for (const auto& [simpler, richer] : std::vector<std::pair<std::string, std::string>>{{"sphere", "ellipsoid"},
+                                                                                      {"ellipsoid", "superellipsoid"},
+                                                                                      {"ellipsoid", "ovoid"},
+                                                                                      {"superellipsoid", "superovoid"},
+                                                                                      {"ovoid", "superovoid"}}) {
+    std::vector<double> p_values;
+    std::vector<bool> needed;
+    for (const auto& [id, results] : finished) {
+      if (!results.contains("selection") || !results.at("selection").is_object()) continue;
+      for (const auto& st : results.at("selection").value("steps", nlohmann::json::array()))
+        if (st.value("simpler", "") == simpler && st.value("richer", "") == richer) {
+          p_values.push_back(st.value("p_value", nlohmann::json()).is_number() ? st.at("p_value").get<double>() : NAN);
+          needed.push_back(st.value("richer_needed", false));
+        }
+    }
+    if (needed.empty()) continue;
+    const CohortStep c = cohortStep(p_values, needed);
+    steps_csv += csvLine({simpler, richer, std::to_string(c.subjects), std::to_string(c.richer_needed), number(c.fisher_p),
+                          number(c.sign_test_p)}) +
+                 "\n";
+    steps_json.push_back({{"simpler", simpler},
+                          {"richer", richer},
+                          {"subjects", c.subjects},
+                          {"richer_needed", c.richer_needed},
+                          {"fisher_p", std::isfinite(c.fisher_p) ? nlohmann::json(c.fisher_p) : nlohmann::json()},
+                          {"sign_test_p", std::isfinite(c.sign_test_p) ? nlohmann::json(c.sign_test_p) : nlohmann::json()}});
+  }
+
+  std::string status_csv =
+      csvLine({"subject", "status", "exit_code", "seconds", "message", "review", "review_note"}) + "\n";
   nlohmann::json status_json = nlohmann::json::array();
+  int n_excluded = 0;
   for (size_t i = 0; i < subjects.size(); ++i) {
     const auto& o = batch.outcomes[i];
-    status_csv += csvLine({o.id, o.status, std::to_string(o.exit_code), number(o.seconds), o.message}) + "\n";
+    const auto rating = ratings.find(o.id);
+    const Rating review = rating == ratings.end() ? Rating{} : rating->second;
+    n_excluded += review.decision == "exclude";
+    status_csv += csvLine({o.id, o.status, std::to_string(o.exit_code), number(o.seconds), o.message, review.decision,
+                           review.note}) +
+                  "\n";
     status_json.push_back({{"subject", o.id},
                            {"status", o.status},
                            {"exit_code", o.exit_code},
                            {"message", o.message},
-                           {"resumed", o.resumed}});
+                           {"resumed", o.resumed},
+                           {"review", review.decision},
+                           {"review_note", review.note}});
   }
 
   nlohmann::json study = {{"subjects", status_json},
                           {"models", summary_json},
+                          {"steps", steps_json},
                           {"succeeded", batch.succeeded},
                           {"failed", batch.failed},
+                          {"excluded", n_excluded},
                           {"coordinate_system", "LPS"},
                           {"units", "mm"},
                           {"provenance", provenance}};
@@ -217,6 +295,7 @@ nlohmann::json writeStudyTables(const fs::path& study_dir, const std::vector<Sub
   writeFileAtomically(study_dir / "study.csv", study_csv);
   writeFileAtomically(study_dir / "study_summary.csv", summary_csv);
   writeFileAtomically(study_dir / "study_status.csv", status_csv);
+  writeFileAtomically(study_dir / "study_steps.csv", steps_csv);
   if (!rows.empty()) writeFileAtomically(study_dir / "study.svg", studyFigure(rows, model_order, study_dir));
   writeFileAtomically(study_dir / "study.html", studyReportHtml(study, finished, study_dir));
   return study;

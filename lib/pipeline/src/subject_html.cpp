@@ -26,17 +26,44 @@ std::string fixed(double v, int digits) {
   return buffer;
 }
 
-// "22.72 ± 0.19" (the 95 % interval's half width), the value alone, or the
-// value marked as one the points do not determine (in the model's
-// not_identifiable: its name is the key without its unit).
+bool listed(const json& names, const std::string& name) {
+  for (const auto& n : names)
+    if (n.is_string() && n.get<std::string>() == name) return true;
+  return false;
+}
+
+// "22.72 ± 0.19" (the 95 % interval's half width), the value alone, "not
+// determined" for a parameter the points leave open (in the model's
+// not_identifiable: its name is the key without its unit), or the value
+// marked as held for an ovoid's gauge (c0x, c0y).
 std::string withInterval(const json& model, const std::string& key, int digits) {
   const double v = numberAt(member(model, "parameters"), key);
   const std::string name = key.substr(0, key.find('_'));
-  for (const auto& open : member(model, "not_identifiable"))
-    if (open.is_string() && open.get<std::string>() == name)
-      return fixed(v, digits) + " <span class=\"note\">(not determined)</span>";
+  if (listed(member(model, "not_identifiable"), name)) return "<span class=\"note\">not determined</span>";
+  if (listed(member(model, "gauge"), name))
+    return fixed(v, digits) + " <span class=\"note\">(held: the scale it shares with " + (name == "c0x" ? "a" : "b") +
+           ")</span>";
   const double se = numberAt(member(model, "standard_errors"), key);
   return fixed(v, digits) + (std::isfinite(se) ? " &plusmn; " + fixed(1.96 * se, digits) : "");
+}
+
+// The semi-axes through the centre with their intervals, "not determined"
+// where the radius along them is open.
+std::string semiAxesWithIntervals(const json& model) {
+  const json& semi = member(model, "semi_axes_mm");
+  const json& se = member(model, "semi_axes_se_mm");
+  std::string out;
+  const char* radius[3] = {"a", "b", "c"};
+  for (size_t k = 0; k < 3 && semi.is_array() && semi.size() == 3; ++k) {
+    out += k ? ", " : "";
+    if (listed(member(model, "not_identifiable"), radius[k])) {
+      out += "<span class=\"note\">not determined</span>";
+      continue;
+    }
+    out += fixed(semi[k].is_number() ? semi[k].get<double>() : NAN, 2);
+    if (se.is_array() && se.size() == 3 && se[k].is_number()) out += " &plusmn; " + fixed(1.96 * se[k].get<double>(), 2);
+  }
+  return out;
 }
 
 // An errors-stage figure, inlined; a note when it is missing.
@@ -72,8 +99,11 @@ std::string verdictSection(const json& results) {
     for (const auto& r : reasons) html += "<li>" + report::escapeMarkup(r.is_string() ? r.get<std::string>() : r.dump()) + "</li>";
     html += "</ul>\n";
   }
-  html += "<table><tr><th>selected model</th><td id=\"selected-model\">" + report::escapeMarkup(selected) +
-          "</td></tr>\n<tr><th>least RMS</th><td>" + report::escapeMarkup(results.value("best_model", "")) + "</td></tr>\n";
+  html += "<table><tr><th>selected model</th><td id=\"selected-model\">" + report::escapeMarkup(selected) + "</td></tr>\n";
+  const std::string least = text(results, "least_rms_model");
+  if (!least.empty() && least != selected)
+    html += "<tr><th>least RMS (not selected)</th><td id=\"least-rms\">" +
+            report::escapeMarkup(least) + "</td></tr>\n";
   std::string open_models;
   for (const auto& m : member(member(results, "selection"), "undetermined"))
     open_models += (open_models.empty() ? "" : ", ") + report::escapeMarkup(m.is_string() ? m.get<std::string>() : "");
@@ -83,22 +113,29 @@ std::string verdictSection(const json& results) {
     html += "<tr><th>head centre (mm, LPS)</th><td id=\"head-centre\">" + withInterval(*m, "t1_mm", 2) + ", " +
             withInterval(*m, "t2_mm", 2) + ", " + withInterval(*m, "t3_mm", 2) + "</td></tr>\n";
     const json& parameters = member(*m, "parameters");
-    std::string radii;
-    for (const char* key : {"a_mm", "b_mm", "c_mm"})
-      if (parameters.contains(key)) radii += (radii.empty() ? "" : ", ") + withInterval(*m, key, 2);
-    html += "<tr><th>radii (mm)</th><td id=\"radii\">" + radii + "</td></tr>\n";
-    const json& semi_axes = member(*m, "semi_axes_mm");
-    if (semi_axes.is_array() && semi_axes.size() == 3 && parameters.contains("c0x"))
+    if (parameters.contains("c0x")) {
       html += "<tr><th>semi-axes through the centre (mm): a&middot;c0x, b&middot;c0y, c</th><td id=\"semi-axes\">" +
-              fixed(semi_axes[0].is_number() ? semi_axes[0].get<double>() : NAN, 2) + ", " +
-              fixed(semi_axes[1].is_number() ? semi_axes[1].get<double>() : NAN, 2) + ", " +
-              fixed(semi_axes[2].is_number() ? semi_axes[2].get<double>() : NAN, 2) +
+              semiAxesWithIntervals(*m) +
               " <span class=\"note\">(an ovoid's a and b share their scale with c0x and c0y; these products are its "
               "shape)</span></td></tr>\n";
+    } else {
+      std::string radii;
+      for (const char* key : {"a_mm", "b_mm", "c_mm"})
+        if (parameters.contains(key)) radii += (radii.empty() ? "" : ", ") + withInterval(*m, key, 2);
+      html += "<tr><th>radii (mm)</th><td id=\"radii\">" + radii + "</td></tr>\n";
+    }
     html += "<tr><th>RMS error (mm)</th><td id=\"rms\">" +
             fixed(numberAt(member(*m, "errors"), "rms_mm"), 3) + "</td></tr>\n";
   }
-  return html + "</table>\n<p class=\"note\">&plusmn;: half the 95 % interval (1.96 standard errors of the fit).</p></section>\n";
+  const json* chosen = modelNamed(results, selected);
+  const json& correlation = member(chosen ? *chosen : results, "residual_correlation");
+  std::string note = "&plusmn;: half the 95 % interval (1.96 standard errors), with the residuals' spatial correlation";
+  if (correlation.is_object())
+    note += " (" + fixed(numberAt(correlation, "n_eff"), 0) + " effective independent points of " +
+            fixed(numberAt(correlation, "n_points"), 0) + ")";
+  note += ". It does not hold a shift of the whole surface shared by every point (an edge found outside a thin "
+          "cortex), nor one that depends on the surface's direction to the slices: the radii carry them.";
+  return html + "</table>\n<p class=\"note\">" + note + "</p></section>\n";
 }
 
 std::string checksSection(const json& results) {
@@ -111,22 +148,90 @@ std::string checksSection(const json& results) {
   return html + "</table></section>\n";
 }
 
+// What the articular selection left out: where the bone departs from the
+// selected model over its cap (results.json's cap_departures).
+std::string departuresSection(const json& results) {
+  const json& d = member(results, "cap_departures");
+  if (!d.is_object()) return "";
+  std::string html = "<section id=\"departures\"><h2>Where the bone departs from the model</h2>\n<p class=\"note\">The bone's "
+                     "surface over the articular cap and its rim, measured against the selected model: regions beyond " +
+                     fixed(numberAt(d, "threshold_mm"), 2) + " mm (the largest of 0.75 mm, three times the points' scatter and 0.3 voxel) and of " +
+                     fixed(numberAt(d, "min_region_mm2"), 0) + " mm&sup2; or more. The points leave them out, so the model "
+                     "describes the rest of the cap. Landmarks departure_1, ... in head.mrk.json; red in the 3-D view.</p>\n";
+  const json& regions = member(d, "regions");
+  if (!regions.is_array() || regions.empty()) return html + "<p>None: the bone follows the model over the cap.</p></section>\n";
+  html += "<table><tr><th>region</th><th>kind</th><th>area (mm&sup2;)</th><th>depth (mm)</th><th>where</th>"
+          "<th>centre (LPS mm)</th></tr>\n";
+  int k = 0;
+  for (const auto& r : regions) {
+    const json& centre = member(r, "centre_mm");
+    std::string at;
+    for (int i = 0; i < 3 && centre.is_array() && centre.size() == 3; ++i)
+      at += (i ? ", " : "") + fixed(centre[static_cast<size_t>(i)].is_number() ? centre[static_cast<size_t>(i)].get<double>() : NAN, 1);
+    const std::string kind = text(r, "kind");
+    html += "<tr><td>departure_" + std::to_string(++k) + "</td><td>" +
+            report::escapeMarkup(kind == "fovea" ? "fovea (a pit at the medial pole: anatomy)" : kind) + "</td><td>" +
+            fixed(numberAt(r, "area_mm2"), 0) + "</td><td>" + fixed(numberAt(r, "depth_mm"), 1) + "</td><td>" +
+            report::escapeMarkup(text(r, "where")) + "</td><td>" + at + "</td></tr>\n";
+  }
+  return html + "</table></section>\n";
+}
+
+// A p-value to three significant digits.
+std::string probability(double p) {
+  if (!std::isfinite(p)) return "-";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", p);
+  return buffer;
+}
+
+// The nested tests of the model selection: the hierarchy's steps, each at
+// alpha, and the walk's tests at their levels.
+std::string selectionTable(const json& results) {
+  const json& selection = member(results, "selection");
+  std::string html = "<h3>Model selection</h3>\n<p class=\"note\">Each step tests whether the richer model's extra "
+                     "parameters are needed: F = (fall of the SSE per extra parameter) / (the richer model's residual "
+                     "variance) &times; n<sub>eff</sub> / n, so that correlated points count as the independent points they "
+                     "are worth. A model the points do not determine is never selected.</p>\n"
+                     "<table id=\"selection-steps\"><tr><th>step</th><th>F</th><th>df</th><th>n<sub>eff</sub></th>"
+                     "<th>p</th><th>level</th><th>richer model needed</th></tr>\n";
+  const auto rows = [&](const json& steps, const std::string& kind) {
+    for (const auto& st : steps)
+      html += "<tr class=\"" + kind + "\"><td>" + report::escapeMarkup(text(st, "simpler")) + " &rarr; " +
+              report::escapeMarkup(text(st, "richer")) + (kind == "path" ? " (walk)" : "") + "</td><td>" +
+              fixed(numberAt(st, "f"), 2) + "</td><td>" + text(st, "df1") + ", " + text(st, "df2") + "</td><td>" +
+              fixed(numberAt(st, "n_eff"), 0) + "</td><td>" + probability(numberAt(st, "p_value")) + "</td><td>" +
+              fixed(numberAt(st, "alpha"), 4) + "</td><td>" + (member(st, "richer_needed") == true ? "yes" : "no") +
+              "</td></tr>\n";
+  };
+  rows(member(selection, "steps"), "step");
+  rows(member(selection, "path"), "path");
+  return html + "</table>\n";
+}
+
 std::string modelsSection(const json& results) {
-  const std::string selected = results.value("selected_model", ""), best = results.value("best_model", "");
+  const std::string selected = results.value("selected_model", ""), best = text(results, "least_rms_model");
   std::string html = "<section id=\"models\"><h2>Models</h2>\n<table><tr><th>model</th><th>parameters</th>"
-                     "<th>RMS (mm)</th><th>mean |d| (mm)</th><th>max |d| (mm)</th><th>AIC</th><th>BIC</th><th></th></tr>\n";
+                     "<th>RMS (mm)</th><th>mean |d| (mm)</th><th>max |d| (mm)</th><th>n<sub>eff</sub></th>"
+                     "<th>correlation lengths (mm)</th><th></th></tr>\n";
   for (const auto& m : member(results, "models")) {
     const json& errors = member(m, "errors");
     const std::string name = m.value("model", "");
     const double max_abs = std::max(std::fabs(numberAt(errors, "min_mm")), std::fabs(numberAt(errors, "max_mm")));
     std::string marks = name == selected ? "selected" : "";
-    if (name == best) marks += marks.empty() ? "least RMS" : ", least RMS";
+    if (name == best && best != selected) marks += "least RMS";
+    const json& rc = member(m, "residual_correlation");
+    const json& lengths = member(rc, "length_mm");
+    std::string length_text;
+    for (const auto& l : lengths)
+      if (l.is_number() && l.get<double>() > 0) length_text += (length_text.empty() ? "" : ", ") + fixed(l.get<double>(), 1);
     html += "<tr data-model=\"" + report::escapeMarkup(name) + "\"><td>" + report::escapeMarkup(name) + "</td><td>" +
             std::to_string(m.value("n_parameters", 0)) + "</td><td class=\"rms\">" + fixed(numberAt(errors, "rms_mm"), 3) +
             "</td><td>" + fixed(numberAt(errors, "mean_abs_mm"), 3) + "</td><td>" + fixed(max_abs, 3) + "</td><td>" +
-            fixed(numberAt(m, "aic"), 1) + "</td><td>" + fixed(numberAt(m, "bic"), 1) + "</td><td>" + marks + "</td></tr>\n";
+            fixed(numberAt(rc, "n_eff"), 0) + "</td><td>" + length_text + "</td><td>" + marks + "</td></tr>\n";
   }
   html += "</table>\n";
+  html += selectionTable(results);
   for (const auto& m : member(results, "models")) {
     html += "<details><summary>" + report::escapeMarkup(m.value("model", "")) + ": parameters</summary><table>";
     for (const auto& [key, value] : member(m, "parameters").items())
@@ -173,9 +278,11 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
   if (sample.contains("selected_points")) p << " (of " << text(sample, "selected_points") << " selected)";
   p << ". Five implicit shape models (sphere, ellipsoid, superellipsoid, ovoid, superovoid) were fitted in a hierarchy, "
        "each from its parent's fit, by least squares of the exact signed Euclidean distances of the points. The "
-    << selected << " was selected as the simplest model whose RMS error exceeded the least by at most the larger of "
-    << fixed(100 * numberAt(selection, "relative_tolerance"), 0) << " % and "
-    << fixed(numberAt(selection, "absolute_tolerance_mm"), 2) << " mm";
+    << selected << " was selected by nested F tests along the hierarchy at a level of "
+    << fixed(numberAt(selection, "alpha"), 2)
+    << " (Bonferroni-corrected over the richer models tested at each step), each counting the points as the "
+       "effective number of independent points their residuals' spatial correlation (a variogram with a nugget and "
+       "two exponential scales) leaves; models whose parameters the points did not determine took no part";
   if (m) {
     const json& parameters = member(*m, "parameters");
     p << "; its RMS error was " << fixed(numberAt(member(*m, "errors"), "rms_mm"), 2) << " mm and its centre lay at ("
@@ -192,12 +299,18 @@ std::string aboutSection(const json& results, const fs::path& folder) {
   std::string html = "<section id=\"about\"><h2>About</h2>\n<table>";
   html += "<tr><th>articula</th><td>" + report::escapeMarkup(text(provenance, "articula_version")) + " (commit " +
           report::escapeMarkup(text(provenance, "git_commit")) + ")</td></tr>";
-  html += "<tr><th>command</th><td><code>" + report::escapeMarkup(text(provenance, "command")) + "</code></td></tr>";
+  // The command the user typed first; the report stage's own when a run ran it.
+  const std::string invoked_by = text(provenance, "invoked_by");
+  html += "<tr><th>command</th><td><code>" + report::escapeMarkup(invoked_by.empty() ? text(provenance, "command") : invoked_by) +
+          "</code></td></tr>";
+  if (!invoked_by.empty())
+    html += "<tr><th>its report stage</th><td><code>" + report::escapeMarkup(text(provenance, "command")) + "</code></td></tr>";
   html += "<tr><th>written</th><td>" + utcNow() + "</td></tr>";
   html += "<tr><th>input</th><td>" + report::escapeMarkup(results.value("input", "")) + "</td></tr>";
   for (const auto& [key, value] : member(provenance, "parameters").items())
-    html += "<tr><th>" + report::escapeMarkup(key) + "</th><td>" + report::escapeMarkup(value.is_string() ? value.get<std::string>() : value.dump()) +
-            "</td></tr>";
+    if (key != "input")  // shown above
+      html += "<tr><th>" + report::escapeMarkup(key) + "</th><td>" +
+              report::escapeMarkup(value.is_string() ? value.get<std::string>() : value.dump()) + "</td></tr>";
   for (const auto& input : member(provenance, "inputs"))
     html += "<tr><th>SHA-256</th><td>" + report::escapeMarkup(text(input, "path")) + ": <code>" + report::escapeMarkup(text(input, "sha256")) +
             "</code></td></tr>";
@@ -211,7 +324,7 @@ table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding
 th{background:#f4f4f4}.status{font-size:1.3em}.status.pass{color:#176f2c}.status.warn{color:#a15c00}
 .status.fail{color:#b00020}tr.fail td{background:#fde7e9}tr.warn td{background:#fff4e0}figure{margin:1em 0}
 figure svg{max-width:100%;height:auto}.slices{display:flex;flex-wrap:wrap;gap:.5em}
-.slices figure{margin:0}
+.slices figure{margin:0;max-width:240px}.slices figcaption{font-size:.85em}
 .view3d-controls label{margin-right:1em}.colour-bar{display:flex;align-items:center;gap:.5em;max-width:960px;margin:.3em 0}
 .colour-bar .bar{flex:1;height:12px;border:1px solid #999}.note{color:#666;font-size:.9em}code{font-size:.9em})";
 
@@ -221,13 +334,16 @@ std::string subjectReportHtml(const json& results, const fs::path& folder, const
                               const std::string& view_html) {
   const std::string title = "articula: " + results.value("side", "") + " " + results.value("joint", "") + " head";
   std::string html = report::htmlPageStart(title, kStyle) + "<h1>" + report::escapeMarkup(title) + "</h1>\n<p>" +
-                     report::escapeMarkup(results.value("input", "")) + "</p>\n";
+                     report::escapeMarkup(results.value("input", "")) + "</p>\n";  // A subject of a study (STUDY/subjects/<id>/): the way back to its study page.
+  if (fs::absolute(folder).lexically_normal().parent_path().filename() == "subjects")
+    html += "<p><a href=\"../../study.html\">&larr; the study</a></p>\n";
   html += verdictSection(results);
   html += view_html;
   html += "<section id=\"slices\"><h2>CT through the head</h2>\n<p class=\"note\">The selected model's outline in "
           "magenta, the segmentation's edge in yellow; radiological view (the patient's left on the right).</p>\n" +
           slices_html + "</section>\n";
   html += checksSection(results);
+  html += departuresSection(results);
   html += modelsSection(results);
   html += "<section id=\"errors\"><h2>Signed distances of the points to each model</h2>\n" +
           inlineSvg(folder / "errors" / "histogram.svg") + "\n" + inlineSvg(folder / "errors" / "error_map.svg") +

@@ -20,6 +20,7 @@
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/shape.hpp"
 #include "articula/core/csv.hpp"
+#include "articula/pipeline/cap_departures.hpp"
 #include "articula/pipeline/markups.hpp"
 #include "articula/imaging/edges.hpp"
 #include "articula/imaging/io.hpp"
@@ -28,7 +29,9 @@
 #include "articula/pipeline/slicer_scene.hpp"
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
+#include "articula/points/mesh_file.hpp"
 #include "articula/points/point_io.hpp"
+#include "articula/report/error_map_svg.hpp"
 #include "articula/report/markup_text.hpp"
 
 namespace articula::pipeline {
@@ -50,25 +53,26 @@ std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
   return unit.empty() ? name : name + "_" + unit;
 }
 
-// Whether the points determine a model's centre, radii and exponents: none
-// of them among those fits.json calls not identifiable. Not counted: angles
-// (a spheroid's spin may be open; its shape is not), the ovoid terms, and
-// the ovoids' a and b, which only their products with c0x and c0y fix (a
-// scale shared by two parameters is open on every ovoid, true ones included).
+// Whether the points determine a model's shape and place: none of its
+// parameters among those fits.json calls not identifiable but its angles
+// (a spheroid's spin may be open; its shape is not). An ovoid's c0x and c0y
+// are its gauge (held, fits.json "gauge"), never counted.
 bool determinedByPoints(geometry::ShapeModel model, const json& not_identifiable) {
   const auto names = geometry::parameterNames(model);
   const auto kinds = geometry::parameterKinds(model);
-  const bool ovoid = model == geometry::ShapeModel::Ovoid || model == geometry::ShapeModel::Superovoid;
   for (const auto& item : not_identifiable) {
     const std::string name = item.is_string() ? item.get<std::string>() : "";
     const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) return false;
-    const geometry::ParameterKind kind = kinds[static_cast<size_t>(it - names.begin())];
-    const bool counted = kind == geometry::ParameterKind::Translation || kind == geometry::ParameterKind::Exponent ||
-                         (kind == geometry::ParameterKind::Radius && !(ovoid && (name == "a" || name == "b")));
-    if (counted) return false;
+    if (it == names.end() || kinds[static_cast<size_t>(it - names.begin())] != geometry::ParameterKind::Angle) return false;
   }
   return true;
+}
+
+json stepJson(const NestedStep& s) {
+  const auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"simpler", s.simpler}, {"richer", s.richer},   {"f", finite(s.f)},         {"df1", s.df1},
+          {"df2", s.df2},         {"n_eff", finite(s.n_eff)}, {"p_value", finite(s.p_value)}, {"alpha", finite(s.alpha)},
+          {"richer_needed", s.richer_needed}};
 }
 
 // The half widths through the centre along the local axes: an ovoid's a
@@ -88,8 +92,10 @@ json readStageJson(const fs::path& path) {
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
 QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
-                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct) {
+                          const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct,
+                          const std::optional<CapDepartures>& departures) {
   HeadQcInput in;
+  if (departures) in.cap_departure_mm2 = departures->largestFindingMm2();
   const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
@@ -113,11 +119,21 @@ QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
   if (ct) {
     in.head_outside_volume_share = headOutsideVolumeShare(ct->geometry, in.points, in.sphere_center, in.sphere_radius_mm);
     in.metal_near_head_mm3 = metalNearHead(*ct, in.sphere_center, in.sphere_radius_mm);
+    in.head_beyond_fov_mm = headBeyondFieldOfView(ct->geometry, in.sphere_center, in.sphere_radius_mm);
+  }
+  const fs::path mesh_summary = folder / "bone.vtp.json";
+  if (fs::exists(mesh_summary)) {
+    const json mesh = readStageJson(mesh_summary);
+    if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("moved") &&
+        mesh.at("ct_edges").at("moved").is_boolean())
+      in.surface_on_ct_edges = mesh.at("ct_edges").at("moved").get<bool>();
   }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);
     try {
+      for (const auto& w : seg.value("warnings", json::array()))
+        if (w.is_string()) in.stage_warnings.push_back(w.get<std::string>());
       if (seg.contains("head_depth_mm")) in.label_depth_mm = seg.at("head_depth_mm").get<double>();
       if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
         const auto& sc = seg.at("head_center_mm");
@@ -172,6 +188,36 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volu
   }
 }
 
+// Where the bone's mesh departs from the selected model over the cap
+// (pipeline/cap_departures.hpp); none without the mesh.
+std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const std::optional<points::MeshFile>& bone,
+                                                 const geometry::ShapeParameters& model, const imaging::Volume* ct,
+                                                 const std::string& joint, const std::string& side) {
+  if (!bone) return std::nullopt;
+  const points::MeshFile& mesh = *bone;
+  CapDepartureInput in;
+  in.vertices = mesh.vertices;
+  in.triangles = mesh.triangles;
+  in.model = model;
+  in.points = points::readPoints(folder / "points.ply").positions;
+  if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
+  in.ct = ct;
+  // LPS: +x is the patient's left, so a right hip's medial side is +x.
+  if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
+  return capDepartures(in);
+}
+
+// The bone's triangles whose corners all lie in one departing region (a
+// fovea aside), for the 3-D view.
+report::ViewSurface departingSurface(const points::MeshFile& bone, const CapDepartures& departures) {
+  const auto region = [&departures](int v) { return departures.region_of_vertex[static_cast<size_t>(v)]; };
+  return meshPart(bone, "departing from the model", [&](Eigen::Index f) {
+    const int r = region(bone.triangles(f, 0));
+    return r >= 0 && region(bone.triangles(f, 1)) == r && region(bone.triangles(f, 2)) == r &&
+           departures.regions[static_cast<size_t>(r)].kind != "fovea";
+  });
+}
+
 }  // namespace
 
 QcReport writeSubjectReport(const SubjectReportOptions& o) {
@@ -184,9 +230,9 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     throw InputError("cannot read the error summary '" + summary_path.string() + "': " + e.what());
   }
   const auto shapes = fit::shapesFromFitsJson(fits, fits_path.string());
-  const std::string best = fits.value("best_model", "");
+  const std::string best = fits.value("least_rms_model", fits.value("best_model", ""));
   json models = json::array();
-  std::vector<std::string> csv_header = {"model", "n_parameters", "aic", "bic", "best_by_rms"};
+  std::vector<std::string> csv_header = {"model", "n_parameters", "aic", "bic", "least_rms"};
   std::string csv_rows;
   geometry::ShapeParameters best_shape = shapes.front();
   for (size_t model_index = 0; model_index < shapes.size(); ++model_index) {
@@ -223,22 +269,48 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       }
       entry["standard_errors"] = standard_errors;
       entry["not_identifiable"] = fit_entry.value("not_identifiable", json::array());
+      entry["gauge"] = fit_entry.value("gauge", json::array());
+      // The semi-axes' standard errors: an ovoid's a c0x and b c0y with c0 held.
+      const json sa = se.value("a", json(nullptr)), sb = se.value("b", sa), sc = se.value("c", sa);
+      const auto scaled = [](const json& v, double f) { return v.is_number() ? json(v.get<double>() * f) : json(nullptr); };
+      const bool ovoid = shape.model == geometry::ShapeModel::Ovoid || shape.model == geometry::ShapeModel::Superovoid;
+      entry["semi_axes_se_mm"] = {scaled(sa, ovoid ? shape.cx[0] : 1.0), scaled(sb, ovoid ? shape.cy[0] : 1.0), scaled(sc, 1.0)};
     }
+    if (fit_entry.contains("residual_correlation")) entry["residual_correlation"] = fit_entry.at("residual_correlation");
     if (n > k && sse > 0) {
       entry["aic"] = aic(sse, n, k);
       entry["bic"] = bic(sse, n, k);
     }
     models.push_back(entry);
   }
-  // The model these points support (see selectParsimonious).
-  std::vector<ModelScore> scores;
+  // The model these points support (see selectNested).
+  std::vector<ModelEvidence> evidence;
   for (size_t i = 0; i < models.size(); ++i) {
     const json& m = models[i];
-    scores.push_back({m.at("model"), m.at("n_parameters"), m.at("errors").value("rms_mm", NAN),
-                      determinedByPoints(shapes[i].model, m.value("not_identifiable", json::array()))});
+    const json& fit_entry = fits.at("models")[i];
+    ModelEvidence e;
+    e.model = m.at("model");
+    e.n_parameters = m.at("n_parameters");
+    e.n_points = m.at("errors").value("n_points", fits.value("n_points", 0));
+    e.sse_mm2 = m.at("errors").value("sse_mm2", fit_entry.value("geometric_objective_mm2", NAN));
+    if (fit_entry.contains("residual_correlation") && fit_entry.at("residual_correlation").is_object())
+      e.n_eff = fit_entry.at("residual_correlation").value("n_eff", NAN);
+    e.determined = determinedByPoints(shapes[i].model, m.value("not_identifiable", json::array()));
+    evidence.push_back(e);
   }
-  const ModelSelection selection = selectParsimonious(scores, o.selection_tolerance, o.selection_floor_mm);
-  csv_header.push_back("selected");
+  const ModelSelection selection = selectNested(evidence, o.selection_alpha);
+  // Per model, the hierarchy's step into it (the superovoid's from its
+  // parent of the lower SSE, as the fit started it).
+  std::map<std::string, NestedStep> step_into;
+  for (const NestedStep& st : selection.steps) {
+    const auto sse = [&evidence](const std::string& name) {
+      for (const auto& e : evidence)
+        if (e.model == name) return e.sse_mm2;
+      return static_cast<double>(NAN);
+    };
+    if (!step_into.count(st.richer) || sse(st.simpler) < sse(step_into[st.richer].simpler)) step_into[st.richer] = st;
+  }
+  csv_header.insert(csv_header.end(), {"selected", "n_eff", "step_from", "step_f", "step_p_value", "richer_needed"});
   // results.csv: one row per model, units in the column names.
   std::vector<std::string> error_columns, parameter_columns;
   for (const auto& m : models) {
@@ -254,25 +326,53 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     std::vector<std::string> f = {m.at("model"), std::to_string(m.at("n_parameters").get<int>()),
                                   m.contains("aic") ? number(m.at("aic")) : "", m.contains("bic") ? number(m.at("bic")) : "",
                                   m.at("model") == best ? "1" : "0", m.at("model") == selection.selected ? "1" : "0"};
+    const json& rc = m.contains("residual_correlation") ? m.at("residual_correlation") : json::object();
+    f.push_back(rc.contains("n_eff") && rc.at("n_eff").is_number() ? number(rc.at("n_eff").get<double>()) : "");
+    const auto st = step_into.find(m.at("model").get<std::string>());
+    const bool stepped = st != step_into.end();
+    f.push_back(stepped ? st->second.simpler : "");
+    f.push_back(stepped && std::isfinite(st->second.f) ? number(st->second.f) : "");
+    f.push_back(stepped && std::isfinite(st->second.p_value) ? number(st->second.p_value) : "");
+    f.push_back(stepped ? (st->second.richer_needed ? "1" : "0") : "");
     for (const auto& c : error_columns) f.push_back(m.at("errors").contains(c) ? number(m.at("errors").at(c).get<double>()) : "");
     for (const auto& c : parameter_columns)
       f.push_back(m.at("parameters").contains(c) ? number(m.at("parameters").at(c).get<double>()) : "");
     csv_rows += csvLine(f) + "\n";
   }
-  // The head centre and axes of the best model, for 3D Slicer.
+  // The head centre and axes of the least-RMS model, for 3D Slicer.
   const Eigen::Matrix3d R = geometry::rotationFromAngles(best_shape.angles);
   const Eigen::Vector3d c = best_shape.center;
   std::vector<LandmarkLine> axes;
   const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
   for (int i = 0; i < 3; ++i)
     axes.push_back({axis_names[i], c - semiAxes(best_shape)[i] * R.col(i), c + semiAxes(best_shape)[i] * R.col(i)});
-  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", {{"head_center", c}}, axes);
-  SlicerSceneContent scene;
-  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", {{"head_center", c}}, axes);
+
+  json steps_json = json::array(), path_json = json::array();
+  for (const NestedStep& st : selection.steps) steps_json.push_back(stepJson(st));
+  for (const NestedStep& st : selection.path) path_json.push_back(stepJson(st));
 
   std::string no_ct;
   const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
-  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get());
+  geometry::ShapeParameters selected_shape = best_shape;
+  for (const auto& shape : shapes)
+    if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
+  std::optional<points::MeshFile> bone;
+  if (fs::exists(o.folder / "bone.vtp")) bone = points::readMeshFile(o.folder / "bone.vtp");
+  const std::optional<CapDepartures> departures =
+      departuresFromModel(o.folder, bone, selected_shape, ct.get(), o.joint, o.side);
+  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get(), departures);
+  // The head centre, and where the bone departs from the selected model.
+  std::vector<Landmark> landmarks = {{"head_center", c}};
+  if (departures)
+    for (size_t k = 0; k < departures->regions.size(); ++k) {
+      const DepartingRegion& region = departures->regions[k];
+      landmarks.push_back({"departure_" + std::to_string(k + 1) + " (" + region.kind + ", " + number(std::round(region.area_mm2)) +
+                               " mm2, " + number(std::round(10 * region.depth_mm) / 10) + " mm)",
+                           region.centre});
+    }
+  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", landmarks, axes);
+  SlicerSceneContent scene;
+  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", landmarks, axes);
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
@@ -281,25 +381,27 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   provenance.parameters = {{"joint", o.joint},
                            {"side", o.side},
                            {"input", o.ct.string()},
-                           {"selection_tolerance", o.selection_tolerance},
-                           {"selection_floor_mm", o.selection_floor_mm}};
+                           {"selection_alpha", o.selection_alpha}};
   const json results = {
       {"input", o.ct.string()},
       {"joint", o.joint},
       {"side", o.side},
-      {"best_model", best},
       {"selected_model", selection.selected},
+      {"least_rms_model", best},
       {"selection",
        {{"rule",
-         "among the models whose centre, radii and exponents the points determine (not undetermined), the "
-         "simplest whose RMS exceeds their least RMS by at most the larger of relative_tolerance x that RMS and "
-         "absolute_tolerance_mm"},
-        {"relative_tolerance", o.selection_tolerance},
-        {"absolute_tolerance_mm", o.selection_floor_mm},
-        {"indistinguishable", selection.indistinguishable},
+         "among the models the points determine (not undetermined), from the sphere: every model containing the "
+         "current one is tested against it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "
+         "n_eff the geometric mean of the two models' effective numbers of independent points) at alpha / their "
+         "number; the simplest "
+         "that passes becomes the current model, until none passes"},
+        {"alpha", o.selection_alpha},
+        {"steps", steps_json},
+        {"path", path_json},
         {"undetermined", selection.undetermined}}},
       {"head_center_mm", {c[0], c[1], c[2]}},
       {"qc", qc.toJson()},
+      {"cap_departures", departures ? departures->toJson() : json(nullptr)},
       {"models", models},
       {"coordinate_system", "LPS"},
       {"units", "mm"},
@@ -314,8 +416,13 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     if (fs::exists(o.folder / "errors" / ("points_" + geometry::modelName(shape.model) + ".vtp")))
       scene.models.push_back(geometry::modelName(shape.model));
   try {
-    const report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
-    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = report::symmetricColourRange(d.signed_distance_mm);
+    report::View3d view = loadHeadView(o.folder, shapes, selection.selected);
+    if (bone && departures) view.departures = departingSurface(*bone, *departures);
+    // One colour, one distance: the error maps' scale on the view and in Slicer.
+    std::vector<report::ErrorMapPanel> panels;
+    for (const auto& d : view.distances) panels.push_back({d.model, d.signed_distance_mm});
+    if (!panels.empty()) view.colour_range_mm = report::sharedColourLimit(panels);
+    for (const auto& d : view.distances) scene.colour_range_mm[d.model] = view.colour_range_mm;
     view_html = report::web3dViewHtml(view);
   } catch (const Error& e) {
     view_html = "<section id=\"view3d\"><h2>3-D view</h2><p class=\"note\">No 3-D view: " + report::escapeMarkup(e.what()) +

@@ -29,17 +29,6 @@ double niceCeil(double v) {
   return 10.0 * p;
 }
 
-double automaticLimit(const std::vector<ErrorMapPanel>& panels) {
-  std::vector<double> a;
-  for (const auto& p : panels)
-    for (Eigen::Index i = 0; i < p.d.size(); ++i)
-      if (std::isfinite(p.d[i])) a.push_back(std::fabs(p.d[i]));
-  if (a.empty()) return niceCeil(0.0);
-  const size_t k = std::min(a.size() - 1, static_cast<size_t>(std::ceil(0.98 * static_cast<double>(a.size()))) - 1);
-  std::nth_element(a.begin(), a.begin() + static_cast<long>(k), a.end());
-  return niceCeil(a[k]);
-}
-
 // The LPS letter a unit direction points to most.
 char anatomical(const Eigen::Vector3d& v) {
   Eigen::Index k;
@@ -55,6 +44,17 @@ int level(double d, double limit) {
 
 }  // namespace
 
+double sharedColourLimit(const std::vector<ErrorMapPanel>& panels) {
+  std::vector<double> a;
+  for (const auto& p : panels)
+    for (Eigen::Index i = 0; i < p.d.size(); ++i)
+      if (std::isfinite(p.d[i])) a.push_back(std::fabs(p.d[i]));
+  if (a.empty()) return niceCeil(0.0);
+  const size_t k = std::min(a.size() - 1, static_cast<size_t>(std::ceil(0.98 * static_cast<double>(a.size()))) - 1);
+  std::nth_element(a.begin(), a.begin() + static_cast<long>(k), a.end());
+  return niceCeil(a[k]);
+}
+
 std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel>& panels,
                         const ErrorMapOptions& options, const std::string& title) {
   options.validate();
@@ -64,7 +64,7 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
     if (p.d.size() != n)
       throw InputError("error map: panel '" + p.label + "' has " + std::to_string(p.d.size()) +
                        " distances, expected one per point (" + std::to_string(n) + ")");
-  const double limit = options.limit_mm > 0.0 ? options.limit_mm : automaticLimit(panels);
+  const double limit = options.limit_mm > 0.0 ? options.limit_mm : sharedColourLimit(panels);
   double extent = n ? map.xy.cwiseAbs().maxCoeff() : 0.0;
   if (!(extent > 0.0)) extent = 1.0;
   const double tick = svg::tickStep(extent, 3);
@@ -107,7 +107,7 @@ std::string errorMapSvg(const AzimuthalMap& map, const std::vector<ErrorMapPanel
     const bool best = !options.highlight.empty() && panel.label == options.highlight;
     out << "<g class=\"panel\">\n<text x=\"" << x0 + side / 2 << "\" y=\"" << y0 - 10 << "\" text-anchor=\"middle\""
         << (best ? " font-weight=\"bold\"" : "") << ">" << escapeMarkup(panel.label) << ": RMS "
-        << svg::label(n ? std::sqrt(sse / static_cast<double>(n)) : 0.0) << " mm" << (best ? " (best)" : "")
+        << svg::label(n ? std::sqrt(sse / static_cast<double>(n)) : 0.0) << " mm" << (best ? " (least RMS)" : "")
         << "</text>\n<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << side << "\" height=\"" << side
         << "\" fill=\"none\" stroke=\"black\"/>\n";
     for (double t = -extent; t <= extent + 1e-9; t += tick)

@@ -101,7 +101,8 @@ std::string histogramSvg(const std::vector<Series>& series, const std::string& t
     const double ly = top + 10 + 18.0 * static_cast<double>(k);
     out << "<line x1=\"" << left + pw - 320 << "\" y1=\"" << ly << "\" x2=\"" << left + pw - 295 << "\" y2=\"" << ly
         << "\" stroke-width=\"2\" stroke=\"" << svg::seriesColour(k) << "\"/><text x=\"" << left + pw - 290 << "\" y=\"" << ly + 4
-        << "\">" << escapeMarkup(s.label) << std::setprecision(3) << " (mu " << s.mu << ", sigma " << s.sigma << " mm)"
+        << "\">" << escapeMarkup(s.label) << std::setprecision(3) << " (\u03bc " << (std::fabs(s.mu) < 5e-4 ? 0.0 : s.mu)
+        << ", \u03c3 " << s.sigma << " mm)"
         << std::setprecision(2) << "</text>\n";
   }
   out << "</svg>\n";

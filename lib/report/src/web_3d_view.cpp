@@ -44,8 +44,8 @@ json surfaceJson(const ViewSurface& surface, const Eigen::Vector3d& centre) {
           {"indices", packed(indices)}};
 }
 
-json colouringJson(const ViewModelDistances& d) {
-  const double range = symmetricColourRange(d.signed_distance_mm);
+json colouringJson(const ViewModelDistances& d, double shared_range_mm) {
+  const double range = shared_range_mm > 0 ? shared_range_mm : symmetricColourRange(d.signed_distance_mm);
   std::vector<std::uint8_t> colours;
   colours.reserve(static_cast<size_t>(d.signed_distance_mm.size()) * 3);
   for (Eigen::Index i = 0; i < d.signed_distance_mm.size(); ++i)
@@ -121,6 +121,7 @@ constexpr const char* kViewScript = R"JS(
     toggles.appendChild(l);
   }
   if (data.bone) toggle('bone', mesh(data.bone, 0xe3d6b8, 0.35), true);
+  if (data.departures) toggle('departing from the model', mesh(data.departures, 0xd62728, 0.9), true);
   var palette = [0x4daf4a, 0xff7f00, 0x984ea3, 0xa65628, 0xe7298a, 0x999999];
   data.surfaces.forEach(function (s, i) {
     toggle(s.name + ' (fitted)', mesh(s, palette[i % palette.length], 0.3), false);
@@ -184,12 +185,14 @@ double symmetricColourRange(const Eigen::VectorXd& signed_distance_mm) {
 std::string web3dViewHtml(const View3d& view) {
   json data = {{"radius_mm", view.radius_mm}, {"selected", view.selected_model}, {"surfaces", json::array()}};
   if (view.bone.vertices.rows() > 0 && view.bone.triangles.rows() > 0) data["bone"] = surfaceJson(view.bone, view.centre);
+  if (view.departures.vertices.rows() > 0 && view.departures.triangles.rows() > 0)
+    data["departures"] = surfaceJson(view.departures, view.centre);
   for (const auto& s : view.fitted)
     if (s.vertices.rows() > 0 && s.triangles.rows() > 0) data["surfaces"].push_back(surfaceJson(s, view.centre));
   if (view.points.rows() > 0) {
     json colourings = json::array();
     for (const auto& d : view.distances)
-      if (d.signed_distance_mm.size() == view.points.rows()) colourings.push_back(colouringJson(d));
+      if (d.signed_distance_mm.size() == view.points.rows()) colourings.push_back(colouringJson(d, view.colour_range_mm));
     data["points"] = {{"positions", positionsAbout(view.points, view.centre)}, {"colourings", colourings}};
   }
   std::string data_text = data.dump();
@@ -199,8 +202,9 @@ std::string web3dViewHtml(const View3d& view) {
   std::string html =
       "<section id=\"view3d\"><h2>3-D view</h2>\n"
       "<p class=\"note\">Drag to turn, scroll to zoom, right-drag to pan. Seen from the front, head up. Tick a fitted "
-      "surface to show it. The points are coloured by their signed distance to the chosen model (98 % of them within the bar's range; the rest "
-      "saturate).</p>\n"
+      "surface to show it. Red: where the bone departs from the selected model (see the departures' table). The points are coloured by their signed distance to the chosen model, on the "
+      "error maps' scale where the report sets one (98 % of all models' distances within the bar; the rest saturate).</p>\n"
+      "<style>#view3d-toggles label{white-space:nowrap;margin-right:.8em}</style>\n"
       "<div class=\"view3d-controls\"><span id=\"view3d-toggles\"></span> <label>colour points by <select "
       "id=\"view3d-colouring\"></select></label></div>\n"
       "<canvas id=\"view3d-canvas\" width=\"960\" height=\"600\" style=\"width:100%;max-width:960px;height:600px;"

@@ -18,6 +18,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/algebraic_start.hpp"
 #include "articula/geometry/pose.hpp"
+#include "articula/geometry/mesh_components.hpp"
 #include "articula/geometry/sphere_fit.hpp"
 
 namespace articula::sampling {
@@ -31,27 +32,16 @@ using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, std::vecto
 using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
 using RansacSphere = CGAL::Shape_detection::Sphere<Traits>;
 
-int findRoot(std::vector<int>& parent, int i) {
-  while (parent[static_cast<size_t>(i)] != i) i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-  return i;
-}
-
 /// The largest connected patch of `chosen` vertices, connected through triangle edges.
 std::vector<int> largestPatch(const std::vector<char>& chosen, const Eigen::MatrixX3i& F) {
-  std::vector<int> parent(chosen.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  for (Eigen::Index t = 0; t < F.rows(); ++t)
-    for (int e = 0; e < 3; ++e) {
-      const int a = F(t, e), b = F(t, (e + 1) % 3);
-      if (chosen[static_cast<size_t>(a)] && chosen[static_cast<size_t>(b)]) parent[static_cast<size_t>(findRoot(parent, a))] = findRoot(parent, b);
-    }
+  const std::vector<int> part = geometry::connectedParts(chosen, F);
   std::vector<int> size(chosen.size(), 0);
-  for (size_t v = 0; v < chosen.size(); ++v)
-    if (chosen[v]) ++size[static_cast<size_t>(findRoot(parent, static_cast<int>(v)))];
+  for (int p : part)
+    if (p >= 0) ++size[static_cast<size_t>(p)];
   const int best = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
   std::vector<int> out;
-  for (size_t v = 0; v < chosen.size(); ++v)
-    if (chosen[v] && findRoot(parent, static_cast<int>(v)) == best) out.push_back(static_cast<int>(v));
+  for (size_t v = 0; v < part.size(); ++v)
+    if (part[v] == best) out.push_back(static_cast<int>(v));
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
 #include "articula/geometry/fibonacci.hpp"
@@ -29,6 +30,32 @@ Eigen::MatrixX3d syntheticCap(const geometry::ShapeParameters& shape, double hal
     Eigen::Vector3d x = s->pose().toGlobal(0.5 * (lo + hi) * dir);
     if (sigma > 0.0) x += noise(rng) * s->gradient(x).normalized();
     pts.row(i) = x.transpose();
+  }
+  return pts;
+}
+
+Eigen::VectorXd exponentialField(const Eigen::MatrixX3d& points, double sigma, double length_mm, unsigned seed) {
+  const Eigen::Index n = points.rows();
+  Eigen::MatrixXd covariance(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j)
+      covariance(i, j) = sigma * sigma * std::exp(-(points.row(i) - points.row(j)).norm() / length_mm);
+  covariance.diagonal().array() += 1e-12 * sigma * sigma;  // roundoff: keep it positive definite
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Eigen::VectorXd z(n);
+  for (Eigen::Index i = 0; i < n; ++i) z[i] = gauss(rng);
+  return covariance.llt().matrixL() * z;
+}
+
+Eigen::MatrixX3d correlatedCap(const geometry::ShapeParameters& shape, double half_angle, int n, double sigma,
+                               double length_mm, unsigned seed) {
+  Eigen::MatrixX3d pts = syntheticCap(shape, half_angle, n, 0.0, seed);
+  const Eigen::VectorXd field = exponentialField(pts, sigma, length_mm, seed);
+  const auto s = geometry::makeSurface(shape);
+  for (Eigen::Index i = 0; i < pts.rows(); ++i) {
+    const Eigen::Vector3d x = pts.row(i).transpose();
+    pts.row(i) += field[i] * s->gradient(x).normalized().transpose();
   }
   return pts;
 }

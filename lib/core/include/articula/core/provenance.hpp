@@ -18,6 +18,11 @@ std::string sha256String(const std::string& bytes);
 std::string commandLine();
 void setCommandLine(int argc, const char* const* argv);
 void setCommandLineString(const std::string& command);
+/// The command a user typed when this one runs inside it (`articula run`
+/// running its stages in its process; "" otherwise): provenance records it
+/// as "invoked_by" beside the stage's own command line.
+std::string invokingCommand();
+void setInvokingCommand(const std::string& command);
 
 struct Provenance {
   nlohmann::json parameters = nlohmann::json::object();
@@ -25,7 +30,7 @@ struct Provenance {
   long long seed = -1;                        // -1: no randomness involved
 };
 
-/// {"articula_version", "git_commit", "command", "seed", "parameters",
+/// {"articula_version", "git_commit", "command", ["invoked_by",] "seed", "parameters",
 ///  "inputs": [{"path","sha256"}], "coordinate_system": "LPS", "units": "mm"}
 nlohmann::json provenanceJson(const Provenance& p);
 

@@ -69,6 +69,7 @@ struct Options {
   double c23_min = -0.1, c23_max = 0.1;   // c2, c3
   /// Overrides by parameter name of table 3.2 ("a", "gamma1", "c2x", "t1", ...).
   std::map<std::string, std::pair<double, double>> bounds;
+  UncertaintyMethod uncertainty = UncertaintyMethod::SpatialModel;  // of every reported model
 
   /// Throws UsageError naming the first bad field.
   void validate() const;
@@ -90,7 +91,7 @@ struct ModelFit {
 
 struct Summary {
   std::vector<ModelFit> fits;      // in hierarchy order, only the requested models
-  std::string best_model;          // lowest RMS; ties go to the simpler model
+  std::string best_model;          // lowest RMS (fits.json "least_rms_model"); ties go to the simpler model
   int points = 0;
   double seconds = 0.0;
   std::string briefReport() const;

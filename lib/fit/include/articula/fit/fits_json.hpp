@@ -2,7 +2,7 @@
 // The fits.json contract (docs/formats.md): one entry of `models` per fitted model
 // with "model", "center_mm", "radii_mm", "rotation_deg" [phi, theta, psi],
 // "rotation_matrix", "exponents", "cx", "cy", objective values and the
-// optimiser's report; plus top-level "best_model".
+// optimiser's report; plus top-level "least_rms_model" (files before it: "best_model").
 #include <filesystem>
 #include <string>
 #include <vector>

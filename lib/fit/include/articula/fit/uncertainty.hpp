@@ -1,24 +1,60 @@
 #pragma once
-// Parameter uncertainty at a least-squares optimum of the signed distances:
-// the Gauss-Newton covariance s^2 (J^T J)^-1, with J the derivatives of the
-// distances with respect to the parameters of thesis table 3.2 and s^2 the
-// residual variance SSE / (n - M). Standard errors, 95 % intervals, and
-// which parameters the points cannot identify (a cap seen from one side
-// leaves some directions of the parameter space nearly free).
+// Parameter uncertainty at a least-squares optimum of the signed distances,
+// for residuals that are correlated over the surface (residual_correlation.hpp).
+//
+// With J the derivatives of the distances with respect to the parameters of
+// thesis table 3.2, the estimate moves with the residuals e as
+// (J^T J)^-1 J^T e, so its covariance is the sandwich
+//   (J^T J)^-1 J^T Sigma J (J^T J)^-1,
+// Sigma the residuals' covariance. Independent residuals (Sigma = s^2 I)
+// give the Gauss-Newton s^2 (J^T J)^-1; on points from a CT surface that is
+// several times too narrow. The default, SpatialModel, takes Sigma from the
+// fit's own variogram (nugget + exponential), its level set so that the
+// expected SSE of the fit equals the SSE found (the fit absorbs the part of
+// a smooth error field that looks like a change of shape, which the
+// residuals then no longer show). It is the limit of a parametric bootstrap
+// with noise of the measured variogram, without the refits. Chosen over the
+// two alternatives below by the coverage of its intervals on phantoms of
+// known shape (docs/benchmarks.md).
+//
+// An ovoid's (a, c_x) and (k a, c_x / k) are one surface: c0x and c0y are
+// held at their fitted values (listed as `gauge`), and a, b and the other
+// ovoid terms get intervals with them held, so that a c0x, the semi-axis,
+// is determined when the points determine the shape.
+//
+// What no interval holds: an offset of the whole surface shared by every
+// point (a cortex's edge found outside the bone by the same amount
+// everywhere) moves the radii by that offset and is not seen in the
+// residuals; docs/user-guide.md names it.
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/shape.hpp"
 
 namespace articula::fit {
 
+enum class UncertaintyMethod {
+  SpatialModel,    // sandwich with the fit's nugget + exponential covariance (the default)
+  Independent,     // Gauss-Newton s^2 (J^T J)^-1, independent residuals
+  SpatialHac,      // Conley's spatial HAC: residual products of point pairs, Bartlett kernel of reach 3 L
+  PatchBootstrap,  // spatial block bootstrap over patches of the cap, linearised (the patch-cluster sandwich)
+};
+std::string uncertaintyMethodName(UncertaintyMethod m);
+/// "spatial-model", "independent", "spatial-hac", "patch-bootstrap"; throws UsageError otherwise.
+UncertaintyMethod uncertaintyMethodFromName(const std::string& name);
+
 struct ParameterUncertainty {
-  Eigen::VectorXd standard_error;           // table 3.2 order; infinity where not identifiable
+  std::string method;                       // uncertaintyMethodName of the method used
+  Eigen::VectorXd standard_error;           // table 3.2 order; infinity where not identifiable or a gauge
   Eigen::VectorXd ci95_lower, ci95_upper;   // estimate -+ 1.96 standard errors
+  Eigen::VectorXd independent_standard_error;  // what independent residuals would give, for comparison
   std::vector<std::string> not_identifiable;  // parameter names: a near-singular J^T J or a very wide interval
-  double condition_number = 0;              // of J^T J with unit-scaled columns
+  std::vector<std::string> gauge;           // held at their fitted values: an ovoid's c0x and c0y
+  double condition_number = 0;              // of J^T J with unit-scaled columns, gauge held
+  ResidualCorrelation correlation;          // of this fit's residuals
 };
 
 /// The uncertainty of `fitted` (a least-squares optimum) on `points` (#P x 3);
@@ -26,6 +62,7 @@ struct ParameterUncertainty {
 /// empty), which spares their global search.
 /// Throws InputError when there are no more points than parameters.
 ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points,
-                                          const Eigen::MatrixX3d& closest = {});
+                                          const Eigen::MatrixX3d& closest = {},
+                                          UncertaintyMethod method = UncertaintyMethod::SpatialModel);
 
 }  // namespace articula::fit

@@ -50,9 +50,13 @@ struct HeadQcInput {
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   std::optional<double> head_outside_volume_share;  // headOutsideVolumeShare, where a CT was given
   std::optional<double> metal_near_head_mm3;     // metalNearHead, where a CT was given
+  std::optional<double> cap_departure_mm2;       // CapDepartures::largestFindingMm2, where the bone's mesh was given
+  std::vector<std::string> stage_warnings;       // what the stages warned of (the segmentation's summary: reading, search)
+  std::optional<bool> surface_on_ct_edges;       // the mesh stage moved the surface onto the CT's edges (else the label's staircase)
   std::string joint;                             // "hip" or "shoulder", for the head's distance from the body's middle
   std::optional<double> body_middle_x_mm;        // the search's body middle (LPS x), if it judged the side by one
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
+  std::optional<double> head_beyond_fov_mm;      // headBeyondFieldOfView, where a CT was given
 };
 
 struct QcCheck {
@@ -108,6 +112,13 @@ std::optional<SocketFacing> socketFacing(const imaging::Volume& ct, const Eigen:
 /// points then cover only what is in view, and the fit extrapolates the rest.
 double headOutsideVolumeShare(const imaging::ImageGeometry& grid, const Eigen::MatrixX3d& points,
                               const Eigen::Vector3d& center, double radius_mm);
+
+/// How far (mm) the fitted sphere reaches beyond the CT's outermost voxel
+/// centres on its farthest side, the neck's side included (0: wholly in
+/// view): a field of view that ends inside the head, also where the share
+/// above misses it (a face on the neck's side clips the head's margin by
+/// the neck, within the cone that share leaves out).
+double headBeyondFieldOfView(const imaging::ImageGeometry& grid, const Eigen::Vector3d& center, double radius_mm);
 
 /// The volume (mm^3) of the voxels above 2,500 HU (metal: screws, stems,
 /// wires; cortical bone stays below) within twice the head's radius of its

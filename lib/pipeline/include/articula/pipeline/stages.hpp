@@ -28,6 +28,8 @@ struct StageDescription {
   /// of later stages nor Snakemake targets, but replaced by a rerun all the
   /// same, so `articula run` checks them as it checks the outputs.
   std::vector<std::string> sidecars;
+  int threads = 1;       // worker threads a job of it uses (a scheduler's request)
+  int memory_mb = 1000;  // memory a job of it needs on a clinical-size CT (a scheduler's request)
 };
 
 /// The arguments with {CT}, {folder}, {joint} and {side} replaced.
@@ -54,7 +56,7 @@ bool isStageFile(const StageDescription& stage, const std::string& file);
 /// The stage's outputs and sidecars that exist in `folder`, relative to it, sorted.
 std::vector<std::string> stageFilesIn(const StageDescription& stage, const std::filesystem::path& folder);
 
-/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments", "sidecars"}, ...]}
+/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments", "sidecars", "threads", "memory_mb"}, ...]}
 nlohmann::json stagesJson();
 
 }  // namespace articula::pipeline

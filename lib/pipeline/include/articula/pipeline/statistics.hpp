@@ -2,6 +2,7 @@
 // Statistics of a morphology study: summaries of signed errors, the paired
 // Wilcoxon signed-rank test, and information criteria that weigh the number
 // of parameters beside the fit.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -31,40 +32,77 @@ WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vecto
 double aic(double sse, int n, int k);
 double bic(double sse, int n, int k);
 
-/// Which model the data support. The least RMS always goes to the most
-/// flexible model, and AIC/BIC on a thousand points from a voxelised,
-/// meshed surface reward fitting its systematic (staircase, smoothing)
-/// deviations: on phantoms of known shape they pick the ovoid for a true
-/// sphere. So the selected model is the simplest (fewest parameters, then
-/// least RMS) whose RMS exceeds the least RMS by no more than the larger of
-/// `relative_tolerance` x the least RMS and `absolute_tolerance_mm`;
-/// `indistinguishable` lists every model within it, i.e. the models these
-/// points cannot tell apart. The absolute part: once the surface sits on the
-/// CT's edge (RMS ~0.1 mm), what is left is a few hundredths of a
-/// millimetre of systematic, direction-dependent error (anisotropic voxels
-/// blur a thin cortex more along their long axis), which a more flexible
-/// model absorbs; on phantoms of known shape it leaves a true sphere 11-15 %
-/// (0.015-0.02 mm) above the ovoids.
-/// Only models the points determine take part: one whose centre, radii or
-/// exponents the points leave open (fit/uncertainty.hpp's not_identifiable;
-/// an angle may be open, as a spheroid's spin is, and so may the ovoid
-/// terms, whose scale the ovoids share with a and b) has
-/// bought its low RMS with freedom the data do not constrain, and its
-/// parameters would be reported as if measured. On a real shoulder an ovoid
-/// with radii at their bounds and +-28 mm intervals had the least RMS but
-/// one. When no model is determined, all take part.
-struct ModelScore {
+/// Which model the points support: a nested test along the hierarchy
+/// sphere -> ellipsoid -> {superellipsoid, ovoid} -> superovoid that counts
+/// the points the residuals' spatial correlation leaves (fit/residual_correlation.hpp).
+///
+/// The test of a simpler model against a richer one that contains it is the
+/// F test of the fall of the sum of squared distances with an effective
+/// number of independent points n_eff, the geometric mean of the two
+/// models' (the simpler model's residuals count the richer model's gain as
+/// correlated noise, the richer model's have absorbed part of the noise):
+///   F = ((SSE_s - SSE_r) / (k_r - k_s)) / (SSE_r / (n - k_r)) x n_eff / n,
+/// on (k_r - k_s, n - k_r) degrees of freedom. A smooth error field (blur,
+/// partial volume, anisotropic voxels) projects onto a richer model's extra
+/// directions about n / n_eff times more than independent noise would; the
+/// denominator's variance comes from all the points. Without the factor
+/// (the plain F test, AIC, BIC) every small gain on a CT surface looks real.
+///
+/// The walk: from the sphere, every determined model that contains the
+/// current one is tested against it at alpha / (their number)
+/// (Bonferroni); the simplest whose test passes (fewest parameters, then
+/// the smaller p) becomes the current model; the walk ends when none
+/// passes. So a superellipsoid of equal radii is reached from the sphere
+/// although the ellipsoid adds nothing.
+///
+/// Only models the points determine take part: one with a centre, radius,
+/// exponent or ovoid term the points leave open (not_identifiable in
+/// fits.json; an open angle, such as a spheroid's spin, is allowed, and an
+/// ovoid's c0x and c0y are a gauge) would report parameters as if measured.
+/// When no model is determined, all take part.
+struct ModelEvidence {
   std::string model;
   int n_parameters = 0;
-  double rms_mm = 0.0;
+  int n_points = 0;
+  double sse_mm2 = NAN;
+  double n_eff = NAN;  // NaN: taken as n_points (independent residuals)
   bool determined = true;
 };
+struct NestedStep {
+  std::string simpler, richer;
+  double f = NAN;          // the statistic above
+  int df1 = 0, df2 = 0;
+  double n_eff = NAN;      // as used: the geometric mean of the two models'
+  double p_value = NAN;    // P(F(df1, df2) >= f)
+  double alpha = NAN;      // the level it was judged at
+  bool richer_needed = false;  // p_value < alpha
+};
+/// The test of `simpler` against `richer` at level `alpha`.
+NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer, double alpha);
+
 struct ModelSelection {
   std::string selected;
-  std::vector<std::string> indistinguishable;  // in the order given
-  std::vector<std::string> undetermined;       // left out, in the order given
+  std::vector<NestedStep> steps;   // the hierarchy's five steps (sphere -> ellipsoid, ellipsoid -> superellipsoid,
+                                   // ellipsoid -> ovoid, superellipsoid -> superovoid, ovoid -> superovoid), each at alpha
+  std::vector<NestedStep> path;    // the tests of the walk, in order, at their Bonferroni levels
+  std::vector<std::string> undetermined;  // left out, in the order given
 };
-ModelSelection selectParsimonious(const std::vector<ModelScore>& scores, double relative_tolerance = 0.10,
-                                  double absolute_tolerance_mm = 0.03);
+/// `models` in any order (names of geometry::modelName); alpha in [0, 1):
+/// 0 never takes a richer model.
+ModelSelection selectNested(const std::vector<ModelEvidence>& models, double alpha = 0.05);
+
+/// The cohort's evidence for one step from per-subject tests (p-values and
+/// decisions at alpha): Fisher's combination of the p-values (-2 sum ln p
+/// against chi-square with 2k degrees of freedom: is the richer model
+/// needed in any subject?) and a sign test of the decisions (one-sided
+/// binomial, P(X >= x) for X ~ Bin(k, 1/2): does a majority need it?).
+/// Subjects are taken as independent. Fisher's method is carried by single
+/// extreme subjects; the sign test cannot fall below 0.05 with fewer than 5
+/// subjects (0.5^k).
+struct CohortStep {
+  int subjects = 0, richer_needed = 0;
+  double fisher_p = NAN, sign_test_p = NAN;
+};
+CohortStep cohortStep(const std::vector<double>& p_values, const std::vector<bool>& richer_needed);
 
 }  // namespace articula::pipeline

@@ -3,10 +3,16 @@
 // `articula run`):
 //   study.csv          one row per subject x model: parameters and error statistics
 //   study_summary.csv  per model: mean and sd of RMS across subjects, how often
-//                      it is best (by RMS, AIC, BIC), mean AIC/BIC difference to
+//                      it is selected and how often least by RMS, AIC, BIC, mean AIC/BIC difference to
 //                      the sphere, and the paired Wilcoxon signed-rank p-value of
 //                      its RMS against the sphere's
-//   study_status.csv   one row per subject: status, exit code, message
+//   study_status.csv   one row per subject: status, exit code, message, and
+//                      the reviewer's decision and note (ratings.hpp); the
+//                      tables leave the excluded subjects out
+//   study_steps.csv    per step of the hierarchy (sphere -> ellipsoid, ...):
+//                      how many subjects need the richer model, Fisher's
+//                      combination of their p-values and a sign test of
+//                      their decisions (pipeline::cohortStep)
 //   study.json         all of the above, with provenance
 //   study.svg          RMS per model for each subject, with the per-model means
 //                      (when at least one subject succeeded)

@@ -12,21 +12,16 @@
 
 namespace articula::pipeline {
 
-// Default of --selection-tolerance: models whose RMS is within 10 % of the
-// least are not told apart; on phantoms of known shape
-// (tests/apps/batch_killed.sh) the voxelised surface leaves the true model
-// 4-9 % above the most flexible one.
-constexpr double kDefaultSelectionTolerance = 0.10;
-// Default of --selection-floor (see pipeline::selectParsimonious).
-constexpr double kDefaultSelectionFloorMm = 0.03;
+// Default of --selection-alpha: the level of the nested tests of the model
+// selection (pipeline::selectNested).
+constexpr double kDefaultSelectionAlpha = 0.05;
 
 struct SubjectReportOptions {
   std::filesystem::path folder;  // holds fits.json, errors/summary.json, points.ply (and label.nii.gz.json)
   std::filesystem::path ct;      // the subject's CT (recorded; hashed when it is a file; sliced for report.html)
   std::string series_uid;        // the CT's series, in a DICOM folder of several
   std::string joint = "hip", side = "right";
-  double selection_tolerance = kDefaultSelectionTolerance;
-  double selection_floor_mm = kDefaultSelectionFloorMm;
+  double selection_alpha = kDefaultSelectionAlpha;
   long long seed = -1;           // recorded in the provenance
 };
 

@@ -15,11 +15,17 @@ struct ErrorMapPanel {
   Eigen::VectorXd d;   // #P signed distances (mm), negative inside, in the map's point order
 };
 
+/// The colour scale's limit an error map takes by default: the 98th
+/// percentile of |d| over all panels, rounded up to 1, 1.5, 2, 2.5, 3, 4, 5,
+/// 6 or 8 x 10^k (the report's 3-D view and Slicer scene use it too, so that
+/// one colour means one distance on every figure of a subject).
+double sharedColourLimit(const std::vector<ErrorMapPanel>& panels);
+
 struct ErrorMapOptions {
   double limit_mm = 0.0;   // colour scale -limit .. +limit; 0: the 98th percentile of |d| over
                            // all panels, rounded up to 1, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 x 10^k
   int max_points = 2000;   // points drawn per panel: every k-th, k = ceil(#P / max_points)
-  std::string highlight;   // the label of the panel to mark as "best" (may be empty)
+  std::string highlight;   // the label of the panel to mark as "least RMS" (may be empty)
   /// Throws InvalidParameter for a negative limit or max_points < 1.
   void validate() const;
 };

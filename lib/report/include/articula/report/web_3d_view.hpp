@@ -32,6 +32,8 @@ struct View3d {
   std::vector<ViewModelDistances> distances;         // the points' colourings, one per model
   std::vector<ViewSurface> fitted;                   // the fitted surfaces, named by model
   std::string selected_model;                        // coloured and shown first
+  ViewSurface departures;                            // where the bone departs from the selected model (none: not shown)
+  double colour_range_mm = 0;                        // every colouring's range; 0: each its own (symmetricColourRange)
 };
 
 /// The signed-distance range a colouring spans, symmetric about 0: the 98th

@@ -1,0 +1,267 @@
+#include "articula/fit/residual_correlation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <vector>
+
+namespace articula::fit {
+namespace {
+
+constexpr int kVariogramPoints = 2000;
+constexpr int kBins = 32;
+constexpr int kMaxCellsAlong = 48;  // cells of at least 1/48 of the extent: at most a few thousand on a cap
+constexpr int kSameCellSample = 16;  // points of a cell whose pairs give its mean kernel
+
+struct Bin {
+  double sum_sq = 0, sum_h = 0;
+  long count = 0;
+};
+
+// gamma(h) = c0 + c1 (1 - exp(-h/L1)) + c2 (1 - exp(-h/L2)) for given lengths:
+// non-negative weighted least squares (every subset of the three terms
+// solved free, the best with no negative coefficient kept); returns the
+// weighted residual, or infinity.
+double fitAtLengths(const std::vector<double>& h, const std::vector<double>& gamma, const std::vector<double>& weight,
+                    double l1, double l2, Eigen::Vector3d& c) {
+  const auto bins = static_cast<Eigen::Index>(h.size());
+  Eigen::MatrixXd X(bins, 3);
+  Eigen::VectorXd y(bins), w(bins);
+  for (Eigen::Index k = 0; k < bins; ++k) {
+    X.row(k) << 1.0, 1.0 - std::exp(-h[static_cast<size_t>(k)] / l1), 1.0 - std::exp(-h[static_cast<size_t>(k)] / l2);
+    y[k] = gamma[static_cast<size_t>(k)];
+    w[k] = weight[static_cast<size_t>(k)];
+  }
+  double best = INFINITY;
+  for (int subset = 1; subset < 8; ++subset) {
+    std::vector<Eigen::Index> cols;
+    for (Eigen::Index j = 0; j < 3; ++j)
+      if (subset & (1 << j)) cols.push_back(j);
+    const auto q = static_cast<Eigen::Index>(cols.size());
+    Eigen::MatrixXd A(bins, q);
+    for (Eigen::Index j = 0; j < q; ++j) A.col(j) = X.col(cols[static_cast<size_t>(j)]);
+    const Eigen::MatrixXd normal = A.transpose() * w.asDiagonal() * A;
+    const Eigen::VectorXd solution = normal.ldlt().solve(A.transpose() * w.asDiagonal() * y);
+    if (!solution.allFinite() || solution.minCoeff() < 0) continue;
+    const double sse = (w.array() * (y - A * solution).array().square()).sum();
+    if (sse < best) {
+      best = sse;
+      c.setZero();
+      for (Eigen::Index j = 0; j < q; ++j) c[cols[static_cast<size_t>(j)]] = solution[j];
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+double nEffective(const ResidualCorrelation& c, double covariance_sum) {
+  return covariance_sum > 0 ? static_cast<double>(c.n) * static_cast<double>(c.n) * c.variance() / covariance_sum
+                            : static_cast<double>(c.n);
+}
+
+ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, const Eigen::VectorXd& residual,
+                                                unsigned seed, bool with_n_eff) {
+  ResidualCorrelation out;
+  const Eigen::Index n = points.rows();
+  out.n = static_cast<int>(n);
+  out.n_eff = static_cast<double>(n);
+  if (n < 3) return out;
+  std::vector<Eigen::Index> sample(static_cast<size_t>(n));
+  std::iota(sample.begin(), sample.end(), Eigen::Index{0});
+  if (n > kVariogramPoints) {
+    std::mt19937 rng(seed);
+    std::shuffle(sample.begin(), sample.end(), rng);
+    sample.resize(kVariogramPoints);
+  }
+  const Eigen::Vector3d extent = points.colwise().maxCoeff() - points.colwise().minCoeff();
+  const double h_max = 0.5 * extent.norm();
+  if (!(h_max > 0)) return out;
+  std::vector<Bin> bins(kBins);
+  const double per_bin = kBins / h_max;
+  for (size_t i = 0; i < sample.size(); ++i) {
+    const Eigen::Vector3d xi = points.row(sample[i]).transpose();
+    const double ri = residual[sample[i]];
+    for (size_t j = i + 1; j < sample.size(); ++j) {
+      const double h = (points.row(sample[j]).transpose() - xi).norm();
+      const int k = static_cast<int>(h * per_bin);
+      if (k >= kBins) continue;
+      const double d = ri - residual[sample[j]];
+      bins[static_cast<size_t>(k)].sum_sq += d * d;
+      bins[static_cast<size_t>(k)].sum_h += h;
+      ++bins[static_cast<size_t>(k)].count;
+    }
+  }
+  std::vector<double> h, gamma, weight;
+  for (const Bin& b : bins)
+    if (b.count && b.sum_sq > 0) {
+      const double g = b.sum_sq / (2.0 * static_cast<double>(b.count));
+      h.push_back(b.sum_h / static_cast<double>(b.count));
+      gamma.push_back(g);
+      weight.push_back(static_cast<double>(b.count));
+    }
+  if (h.size() < 3) return out;
+  // Lengths from a fiftieth of a bin to half the extent, 40 per grid.
+  const double l_min = 0.02 * h_max / kBins, l_max = h_max;
+  constexpr int kGrid = 40;
+  std::vector<double> grid;
+  for (int g = 0; g < kGrid; ++g) grid.push_back(l_min * std::pow(l_max / l_min, g / (kGrid - 1.0)));
+  // One scale (L1 = L2), then two; the second kept only where it cuts the
+  // weighted misfit to under 0.3 of one scale's: a single field's variogram wobbles at long lags,
+  // and a second scale fitted to the wobbles makes n_eff a fraction of the
+  // truth (on fields of one known length, tests/lib/fit_test.cpp).
+  double one = INFINITY, two = INFINITY;
+  Eigen::Vector3d c_one = Eigen::Vector3d::Zero(), c_two = Eigen::Vector3d::Zero();
+  double l_one = 0, l_two_a = 0, l_two_b = 0;
+  for (size_t i = 0; i < grid.size(); ++i)
+    for (size_t j = i; j < grid.size(); ++j) {
+      Eigen::Vector3d c;
+      const double sse = fitAtLengths(h, gamma, weight, grid[i], grid[j], c);
+      if (i == j && sse < one) one = sse, c_one = c, l_one = grid[i];
+      if (i != j && sse < two) two = sse, c_two = c, l_two_a = grid[i], l_two_b = grid[j];
+    }
+  // The grid's steps are 21 % apart: refine each length over the step about it.
+  const double step = std::pow(l_max / l_min, 1.0 / (kGrid - 1.0));
+  for (int g = -10; g <= 10; ++g) {
+    Eigen::Vector3d c;
+    const double l = std::clamp(l_one * std::pow(step, g / 10.0), l_min, l_max);
+    const double sse = fitAtLengths(h, gamma, weight, l, l, c);
+    if (sse < one) one = sse, c_one = c, l_one = l;
+  }
+  const double a0 = l_two_a, b0 = l_two_b;
+  for (int ga = -5; ga <= 5; ++ga)
+    for (int gb = -5; gb <= 5; ++gb) {
+      Eigen::Vector3d c;
+      const double la = std::clamp(a0 * std::pow(step, ga / 5.0), l_min, l_max);
+      const double lb = std::clamp(b0 * std::pow(step, gb / 5.0), l_min, l_max);
+      if (la >= lb) continue;
+      const double sse = fitAtLengths(h, gamma, weight, la, lb, c);
+      if (sse < two) two = sse, c_two = c, l_two_a = la, l_two_b = lb;
+    }
+  constexpr double kSecondScaleGain = 0.3;
+  if (two < kSecondScaleGain * one) {
+    out.nugget_mm2 = c_two[0];
+    out.sill_mm2 = {c_two[1], c_two[2]};
+    out.length_mm = {l_two_a, l_two_b};
+  } else {
+    out.nugget_mm2 = c_one[0];
+    out.sill_mm2 = {c_one[1] + c_one[2], 0.0};
+    out.length_mm = {l_one, 0.0};
+  }
+  for (int k = 0; k < 2; ++k)
+    if (!(out.sill_mm2[k] > 0)) out.sill_mm2[k] = 0, out.length_mm[k] = 0;
+  if (out.sill_mm2[0] == 0 && out.sill_mm2[1] > 0) {  // the one part found goes first
+    std::swap(out.sill_mm2[0], out.sill_mm2[1]);
+    std::swap(out.length_mm[0], out.length_mm[1]);
+  }
+  // n_eff = n^2 var / sum_ij cov_ij: the variance of the residuals' mean is var / n_eff.
+  if (with_n_eff && out.sill_mm2.sum() > 0)
+    out.n_eff = nEffective(out, covarianceGram(points, Eigen::MatrixXd::Ones(n, 1), out)(0, 0));
+  return out;
+}
+
+Eigen::MatrixXd kernelGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                           const std::function<double(double)>& kernel, double reach_mm, double cell_mm) {
+  const Eigen::Index n = points.rows(), m = a.cols();
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(m, m);
+  if (n == 0) return gram;
+  const Eigen::Vector3d lo = points.colwise().minCoeff().transpose();
+  const double extent = (points.colwise().maxCoeff().transpose() - lo).maxCoeff();
+  const double cell = std::max({cell_mm, extent / kMaxCellsAlong, 1e-9});
+  // Cells on a dense grid of at most 49^3 (kMaxCellsAlong + 1 along each axis).
+  const Eigen::Vector3i dims =
+      ((points.colwise().maxCoeff().transpose() - lo) / cell).array().floor().cast<int>() + 1;
+  std::vector<int> index(static_cast<size_t>(dims.prod()), -1);
+  const auto flat = [&dims](const Eigen::Vector3i& c) {
+    return static_cast<size_t>((c[0] * dims[1] + c[1]) * dims[2] + c[2]);
+  };
+  std::vector<int> cell_of(static_cast<size_t>(n));
+  std::vector<Eigen::Vector3i> coords;
+  std::vector<std::vector<Eigen::Index>> members;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3i c =
+        ((points.row(i).transpose() - lo) / cell).array().floor().cast<int>().min(dims.array() - 1).max(0);
+    int& at = index[flat(c)];
+    if (at < 0) {
+      at = static_cast<int>(coords.size());
+      coords.push_back(c);
+      members.emplace_back();
+    }
+    cell_of[static_cast<size_t>(i)] = at;
+    members[static_cast<size_t>(at)].push_back(i);
+  }
+  const int cells = static_cast<int>(coords.size());
+  Eigen::MatrixXd sums = Eigen::MatrixXd::Zero(cells, m);
+  Eigen::MatrixX3d centroid = Eigen::MatrixX3d::Zero(cells, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    sums.row(cell_of[static_cast<size_t>(i)]) += a.row(i);
+    centroid.row(cell_of[static_cast<size_t>(i)]) += points.row(i);
+  }
+  // Within a cell: the mean kernel of its points' pairs off the diagonal.
+  const double k0 = kernel(0.0);
+  Eigen::VectorXd same(cells);
+  for (int c = 0; c < cells; ++c) {
+    const auto& p = members[static_cast<size_t>(c)];
+    centroid.row(c) /= static_cast<double>(p.size());
+    const size_t used = std::min<size_t>(p.size(), kSameCellSample);
+    double sum = 0;
+    int pairs = 0;
+    for (size_t i = 0; i < used; ++i)
+      for (size_t j = i + 1; j < used; ++j, ++pairs) sum += kernel((points.row(p[i]) - points.row(p[j])).norm());
+    same[c] = pairs ? sum / pairs : k0;
+  }
+  Eigen::VectorXd diagonal_weight(n);
+  for (Eigen::Index i = 0; i < n; ++i) diagonal_weight[i] = k0 - same[cell_of[static_cast<size_t>(i)]];
+  gram += a.transpose() * diagonal_weight.asDiagonal() * a;
+  gram += sums.transpose() * same.asDiagonal() * sums;
+  // Between cells: each cell's kernel-weighted sum of its neighbours.
+  Eigen::MatrixXd neighbours = Eigen::MatrixXd::Zero(cells, m);
+  // Neighbouring cells: the offsets whose nearest points may lie within reach.
+  const int r = static_cast<int>(std::ceil(reach_mm / cell));
+  std::vector<Eigen::Vector3i> offsets;
+  for (int dx = -r; dx <= r; ++dx)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dz = -r; dz <= r; ++dz) {
+        const Eigen::Vector3d gap = (Eigen::Vector3i(dx, dy, dz).cwiseAbs().array() - 1).max(0).cast<double>() * cell;
+        if ((dx || dy || dz) && gap.norm() <= reach_mm) offsets.emplace_back(dx, dy, dz);
+      }
+  if (offsets.size() >= static_cast<size_t>(cells)) {
+    for (int c = 0; c < cells; ++c)
+      for (int d = c + 1; d < cells; ++d) {
+        const double h = (centroid.row(c) - centroid.row(d)).norm();
+        if (h > reach_mm) continue;
+        const double k = kernel(h);
+        neighbours.row(c) += k * sums.row(d);
+        neighbours.row(d) += k * sums.row(c);
+      }
+  } else {
+    for (int c = 0; c < cells; ++c)
+      for (const Eigen::Vector3i& offset : offsets) {
+        const Eigen::Vector3i o = coords[static_cast<size_t>(c)] + offset;
+        if ((o.array() < 0).any() || (o.array() >= dims.array()).any()) continue;
+        const int d = index[flat(o)];
+        if (d < 0) continue;
+        const double h = (centroid.row(c) - centroid.row(d)).norm();
+        if (h <= reach_mm) neighbours.row(c) += kernel(h) * sums.row(d);
+      }
+  }
+  gram += sums.transpose() * neighbours;
+  return 0.5 * (gram + gram.transpose());
+}
+
+Eigen::MatrixXd exponentialGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                                double length_mm) {
+  return kernelGram(points, a, [length_mm](double h) { return std::exp(-h / length_mm); }, 6.0 * length_mm,
+                    0.5 * length_mm);
+}
+
+Eigen::MatrixXd covarianceGram(const Eigen::MatrixX3d& points, const Eigen::Ref<const Eigen::MatrixXd>& a,
+                               const ResidualCorrelation& c) {
+  Eigen::MatrixXd gram = c.nugget_mm2 * (a.transpose() * a);
+  for (int k = 0; k < 2; ++k)
+    if (c.sill_mm2[k] > 0 && c.length_mm[k] > 0) gram += c.sill_mm2[k] * exponentialGram(points, a, c.length_mm[k]);
+  return gram;
+}
+
+}  // namespace articula::fit
