@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """The bone surface's mean signed distance to the true head over a grid of
 voxel sizes (in-plane x slice), on heads of all three phantom generators:
-`articula phantom` (normal and osteoporotic bone), bench/independent_phantom.py
-and bench/third_phantom.py (a 1.2 mm and a thin cortex each). Each cell runs
+`articula phantom` (normal and osteoporotic bone, and osteoporotic bone in
+slices 1 mm thicker than their spacing), bench/independent_phantom.py and
+bench/third_phantom.py (a 1.2 mm and a thin cortex each). Each cell runs
 `articula run` on one CT and scores its articular points against the truth
 (mean signed distance, positive outside; RMS). Phantoms are cached in
 WORK/phantoms; runs go to WORK/runs. Prints a markdown table (one row per head,
@@ -25,10 +26,13 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 PY = os.environ.get("PYTHON", "/usr/bin/python3")  # Debian's, with numpy and scipy
 
-# name -> (generator, options); the voxel size is added per cell.
+# name -> (generator, options); the voxel size is added per cell (SLICE+1:
+# the cell's slice spacing plus a millimetre).
 CASES = {
     "articula-normal": ("articula", ["--seed", "11", "--radius", "23", "--gap", "2"]),
     "articula-osteoporotic": ("articula", ["--seed", "12", "--radius", "21", "--gap", "2", "--osteoporotic"]),
+    "articula-thick-slices": ("articula", ["--seed", "13", "--radius", "24", "--gap", "2.5", "--osteoporotic",
+                                           "--slice-thickness", "SLICE+1"]),
     "independent-normal": ("independent", ["side=right", "R=23", "gap=2", "seed=1"]),
     "independent-thin": ("independent", ["side=right", "R=25", "gap=2.5", "cortex=0.8", "cort_hu=800", "trab_hu=200",
                                          "seed=5"]),
@@ -49,6 +53,7 @@ def make_phantom(gen, opts, spacing, folder):
     """Writes the CT (returns its path and the truth's path) unless cached
     with the same options."""
     sp = ",".join(f"{v:g}" for v in spacing)
+    opts = [f"{spacing[2] + 1:g}" if o == "SLICE+1" else o for o in opts]
     stamp, said = f"{folder}/options.txt", " ".join([gen, sp, *opts])
     if os.path.exists(stamp) and open(stamp).read() != said:
         shutil.rmtree(folder)
