@@ -21,7 +21,8 @@ constexpr double kMinAcrossShare = 0.1;  // of the lines' summed slice share, fo
 constexpr double kWidthRange = 2.5;      // each width within this factor of the common one
 constexpr double kSocketRiseHu = 150;  // a rise beyond the edge this high is a socket (the edges' least contrast)
 constexpr double kHeldLevelVoxels = 4;          // a held level weighs as much as this many voxels that show it
-constexpr double kHeldAcrossSlicesRatio = 1.2;  // slices this much longer than the in-plane voxel
+constexpr double kHeldAcrossSlicesRatio = 1.2;  // slices this much longer than the in-plane voxel ...
+constexpr double kHeldAcrossBlurRatio = 1.1;    // ... or a blur this much wider across them (an isotropic one: within 0.93-1.07)
 
 constexpr double kTableStepMm = 0.01;    // a voxel-grid blur's step response is tabulated this finely
 constexpr double kGridKernelWidths = 4;  // image filters' usual truncation of a sampled Gaussian
@@ -446,6 +447,10 @@ bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm) {
   return spacing_mm[2] > kHeldAcrossSlicesRatio * std::max(spacing_mm[0], spacing_mm[1]);
 }
 
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm, double sigma_mm, double slice_sigma_mm) {
+  return tissueHeldAcrossSlices(spacing_mm) || slice_sigma_mm > kHeldAcrossBlurRatio * sigma_mm;
+}
+
 std::vector<CortexTissue> nearbyTissue(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector3d>& known_points,
                                        const std::vector<CortexTissue>& known) {
@@ -628,7 +633,8 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
   for (const LineVoxels& line : lines) voxels += static_cast<double>(line.offset_mm.size());
   if (chosen_value - split_value > std::log(voxels)) ps = split;
   ps.found = true;
-  if (tissueHeldAcrossSlices(lines.front().spacing_mm)) ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
+  ps.held_across = tissueHeldAcrossSlices(lines.front().spacing_mm, ps.sigma_mm, ps.slice_sigma_mm);
+  if (ps.held_across) ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
   return ps;
 }
 

@@ -448,17 +448,6 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   std::vector<Eigen::Index> on_edge;
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
     if (found[static_cast<size_t>(v)]) on_edge.push_back(v);
-  // With slices much longer than the in-plane voxels, the lines within the
-  // slices tell the cortex's thickness and levels, and the lines across
-  // them are fitted with those of their neighbourhood (imaging::fitCortex).
-  const bool held_across = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
-  const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
-  std::vector<char> within(static_cast<size_t>(mesh.vertices.rows()), 1);
-  if (held_across)
-    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
-      const double across = on_falls.normals.row(v).dot(slice_axis.transpose());
-      within[static_cast<size_t>(v)] = across * across < imaging::kWithinSlicesShare;
-    }
   imaging::PointSpread spread;
   spread.sigma_mm = options.point_spread_mm;
   spread.slice_sigma_mm = options.slice_point_spread_mm > 0 ? options.slice_point_spread_mm : options.point_spread_mm;
@@ -474,9 +463,24 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     }
     s.point_spread_estimated = true;
   }
+  const bool held_across = s.point_spread_estimated ? spread.held_across
+                                                    : imaging::tissueHeldAcrossSlices(ct.geometry.spacing, spread.sigma_mm,
+                                                                                      spread.slice_sigma_mm);
+  const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
+  std::vector<char> within(static_cast<size_t>(mesh.vertices.rows()), 1);
+  if (held_across)
+    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+      const double across = on_falls.normals.row(v).dot(slice_axis.transpose());
+      within[static_cast<size_t>(v)] = across * across < imaging::kWithinSlicesShare;
+    }
+  s.cortex_held_across_slices = held_across;
   s.point_spread_mm = spread.sigma_mm;
   s.slice_point_spread_mm = spread.slice_sigma_mm;
   s.point_spread_on_voxel_grid = spread.kind == imaging::PointSpread::Kind::VoxelGrid;
+  // With slices much longer than the in-plane voxels or blurred much more
+  // across than within, the lines within the slices tell the cortex's
+  // thickness and levels, and the lines across them are fitted with those
+  // of their neighbourhood (imaging::fitCortex).
   std::vector<imaging::CortexFit> fits(on_edge.size());
   const auto fitLines = [&](bool which, const std::vector<imaging::CortexTissue>* held) {
     parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {

@@ -136,6 +136,10 @@ struct PointSpread {
   double sigma_mm = 0;        // within the slices
   double slice_sigma_mm = 0;  // across them (along the slice axis, the grid's third index)
   int profiles = 0;           // lines it was estimated on
+  /// Whether the lines across the slices take the cortex of the lines
+  /// within them (fitCortex's `held`): on long slices (tissueHeldAcrossSlices)
+  /// or a blur across the slices a tenth wider than within them.
+  bool held_across = false;
   /// The width along a line: the Gaussian's spread in its direction.
   double along(const LineVoxels& line) const {
     return std::sqrt(sigma_mm * sigma_mm * (1 - line.slice_share) + slice_sigma_mm * slice_sigma_mm * line.slice_share);
@@ -160,11 +164,12 @@ struct PointSpread {
 /// slices (their shares summing to less than a tenth of the lines) give one
 /// width for both.
 /// Where the slices are more than a fifth longer than the in-plane voxel
-/// (tissueHeldAcrossSlices), the width across the slices is then estimated
-/// again on the lines across them (slice share kWithinSlicesShare or more),
-/// each fitted with the tissue of its nearest lines within the slices
-/// (nearbyTissue): across long slices a thin cortex's thickness trades
-/// against the blur, and the width with it.
+/// (tissueHeldAcrossSlices), or the width across them comes out more than a
+/// tenth wider than within them, the width across the slices is then
+/// estimated again on the lines across them (slice share kWithinSlicesShare
+/// or more), each fitted with the tissue of its nearest lines within the
+/// slices (nearbyTissue): across long or thick slices a thin cortex's
+/// thickness trades against the blur, and the width with it (held_across).
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
 
 /// Lines whose slice share is below this lie within the slices: across
@@ -173,6 +178,8 @@ constexpr double kWithinSlicesShare = 0.05;
 /// Whether the voxels are long enough across the slices for the lines
 /// across them to take their tissue from the lines within them.
 bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm);
+/// ... or whose point-spread is a tenth wider across the slices than within them.
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm, double sigma_mm, double slice_sigma_mm);
 /// For each of `points`, the median tissue of its nearest (15) `known`
 /// tissues (at `known_points`).
 std::vector<CortexTissue> nearbyTissue(const std::vector<Eigen::Vector3d>& points,

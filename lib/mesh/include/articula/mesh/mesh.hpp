@@ -86,6 +86,7 @@ struct EdgeSnapSummary {
   double point_spread_mm = 0, slice_point_spread_mm = 0;  // within the slices, across them
   bool point_spread_estimated = false;
   bool point_spread_on_voxel_grid = false;  // the blur was an image filter's on the voxels (imaging::PointSpread::Kind)
+  bool cortex_held_across_slices = false;   // the lines across the slices held the cortex of the lines within them
   long long on_cortex_model = 0;
   double mean_model_shift_mm = 0;
   std::string cortex_model_note;  // why the model was not used, when it was asked for
