@@ -516,19 +516,41 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     for (size_t i = 0; i < on_edge.size(); ++i)
       if (!known[static_cast<size_t>(on_edge[i])]) fits[i].found = false;  // no tissue reached it
   }
-  double moved = 0;
+  // From the averaged fall the model's surface lies offset_mm along the
+  // line; the vertex moves along the label's normal, so it goes to where
+  // that normal meets the model's tangent plane (the two normals part by
+  // a few degrees at fine voxels, by up to 30 about a pole's terrace at
+  // 3 mm slices).
+  std::vector<double> correction(shift.size(), 0.0);
+  std::vector<char> corrected(shift.size(), 0);
   for (size_t i = 0; i < on_edge.size(); ++i) {
     if (!fits[i].found) continue;
-    // From the averaged fall the model's surface lies offset_mm along the
-    // line; the vertex moves along the label's normal, so it goes to where
-    // that normal meets the model's tangent plane (the two normals part by
-    // a few degrees at fine voxels, by up to 30 about a pole's terrace at
-    // 3 mm slices).
     const auto v = static_cast<size_t>(on_edge[i]);
     const double cosine = std::max(0.5, mesh.normals.row(on_edge[i]).dot(on_falls.normals.row(on_edge[i])));
-    const double from_fall = averaged[v] + fits[i].offset_mm / cosine - shift[v];
-    shift[v] = averaged[v] + fits[i].offset_mm / cosine;
-    moved += from_fall;
+    correction[v] = averaged[v] + fits[i].offset_mm / cosine - shift[v];
+    corrected[v] = 1;
+  }
+  // Where the lines across the slices hold the tissue, each correction is
+  // averaged once with its neighbours': their fits scatter more (a faint
+  // cortex, 0.6 mm at 500 HU over textured bone at 100 HU, at 0.8 x 0.8 x
+  // 1.25 mm: the points' RMS 0.42 mm against 0.32 averaged).
+  if (held_across) {
+    std::vector<double> next = correction;
+    for (size_t v = 0; v < correction.size(); ++v) {
+      if (!corrected[v]) continue;
+      double sum = correction[v];
+      int count = 1;
+      for (const int w : neighbours[v])
+        if (corrected[static_cast<size_t>(w)]) sum += correction[static_cast<size_t>(w)], ++count;
+      next[v] = sum / count;
+    }
+    correction.swap(next);
+  }
+  double moved = 0;
+  for (size_t v = 0; v < shift.size(); ++v) {
+    if (!corrected[v]) continue;
+    shift[v] += correction[v];
+    moved += correction[v];
     ++s.on_cortex_model;
   }
   s.cortex_model = true;
