@@ -582,10 +582,17 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   // its steepest fall keeps to the middle between two slices (a flat
   // terrace about a head's pole at 3 mm slices) unless the profile is
   // smoothed over about a third of the voxel's extent along the line.
+  // Only where the model follows: its lines start on these falls, and a
+  // smoothed profile's steepest fall lies further out on a thin cortex.
+  const bool cortex_model =
+      options.edge_model == EdgeModel::Cortex ||
+      (options.edge_model == EdgeModel::Automatic &&
+       std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]) <= kCortexModelMaxInPlaneMm + 1e-6 &&
+       ct.geometry.spacing[2] <= kCortexModelMaxSliceMm + 1e-6);
   const bool long_slices = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
   for (Eigen::Index v = 0; v < n; ++v) {
     imaging::EdgeSearch along = search;
-    if (long_slices && options.search_mm <= 0) {
+    if (cortex_model && long_slices && options.search_mm <= 0) {
       const Eigen::Vector3d u = mesh.normals.row(v).transpose();
       const double extent = ct.geometry.spacing.cwiseProduct(ct.geometry.direction.transpose() * u).norm();
       along.smoothing_mm = std::max(std::max(0.15, 0.25 * ct.geometry.spacing.minCoeff()), 0.3 * extent);
@@ -610,11 +617,6 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
       neighbours[static_cast<size_t>(a)].push_back(b);
       neighbours[static_cast<size_t>(b)].push_back(a);
     }
-  const bool cortex_model =
-      options.edge_model == EdgeModel::Cortex ||
-      (options.edge_model == EdgeModel::Automatic &&
-       std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]) <= kCortexModelMaxInPlaneMm + 1e-6 &&
-       ct.geometry.spacing[2] <= kCortexModelMaxSliceMm + 1e-6);
   if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), shift, found);
   for (Eigen::Index v = 0; v < n; ++v) {
