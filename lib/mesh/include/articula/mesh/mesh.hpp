@@ -48,10 +48,10 @@ enum class EdgeModel { Automatic, SteepestFall, Cortex };
 /// The coarsest voxels on which the automatic edge model is the
 /// blurred-cortex model: in-plane voxels up to kCortexModelMaxInPlaneMm and
 /// slices up to kCortexModelMaxSliceMm. There the model's surface lay within
-/// 0.05 mm of the true one on average on the heads of three phantom
-/// generators, thin cortices included, where the steepest fall lay 0.04-0.41
-/// mm outside (docs/benchmarks.md, "Surface bias by voxel size"); on coarser
-/// in-plane voxels (1.5 mm) it is not measured to hold.
+/// 0.05 mm of the true one on average on 65 of 84 heads of three phantom
+/// generators and within 0.1 mm on 82, thin cortices included, where the
+/// steepest fall lay 0.04-0.42 mm outside (docs/benchmarks.md, "Surface bias
+/// by voxel size"); on coarser in-plane voxels (1.5 mm) it is not measured.
 constexpr double kCortexModelMaxInPlaneMm = 1.0, kCortexModelMaxSliceMm = 3.0;
 
 struct EdgeSnapOptions {
