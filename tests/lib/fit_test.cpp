@@ -58,6 +58,16 @@ void expectNested(const Summary& s) {
     }
 }
 
+
+// The fitted axis (a column of `fitted`) most nearly along `axis`: a fit's
+// radii come in its own axes' order.
+int fittedAxisAlong(const Eigen::Matrix3d& fitted, const Eigen::Vector3d& axis) {
+  int j = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(fitted.col(k).dot(axis)) > std::abs(fitted.col(j).dot(axis))) j = k;
+  return j;
+}
+
 TEST(AlgebraicStart, SphereAndEllipsoidExactOnExactPoints) {
   const ShapeParameters e = trueShape(ShapeModel::Ellipsoid);
   const Eigen::MatrixX3d pts = articula::fit::syntheticCap(e, 1.2, 400, 0.0, 1);
@@ -405,9 +415,7 @@ TEST(ParameterUncertainty, IntervalsCoverTheTruthAsOftenAsTheyClaim) {
     const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(f.parameters.angles);
     const auto& u = f.uncertainty;
     for (int i = 0; i < 3; ++i) {
-      int j = 0;
-      for (int k = 1; k < 3; ++k)
-        if (std::abs(Rf.col(k).dot(Rt.col(i))) > std::abs(Rf.col(j).dot(Rt.col(i)))) j = k;
+      const int j = fittedAxisAlong(Rf, Rt.col(i));
       covered[i] += u.ci95_lower[j] <= truth.radii[i] && truth.radii[i] <= u.ci95_upper[j];
       const Eigen::Index t_index = 3 + i;  // ellipsoid: a b c t1 t2 t3 phi theta psi
       covered[3 + i] += u.ci95_lower[t_index] <= truth.center[i] && truth.center[i] <= u.ci95_upper[t_index];
@@ -512,9 +520,7 @@ TEST(ParameterUncertainty, IntervalsHoldWithCorrelatedErrors) {
     const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(f.parameters.angles);
     const auto& u = f.uncertainty;
     for (int i = 0; i < 3; ++i) {
-      int j = 0;
-      for (int k = 1; k < 3; ++k)
-        if (std::abs(Rf.col(k).dot(Rt.col(i))) > std::abs(Rf.col(j).dot(Rt.col(i)))) j = k;
+      const int j = fittedAxisAlong(Rf, Rt.col(i));
       const double radius_miss = std::abs(f.parameters.radii[j] - truth.radii[i]);
       const double centre_miss = std::abs(f.parameters.center[i] - truth.center[i]);
       spatial += (radius_miss <= 1.96 * u.standard_error[j]) + (centre_miss <= 1.96 * u.standard_error[3 + i]);

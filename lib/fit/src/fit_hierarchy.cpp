@@ -943,4 +943,14 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   return summary;
 }
 
+std::string nloptVersion() {
+  int major = 0, minor = 0, bugfix = 0;
+  nlopt::version(major, minor, bugfix);
+  return std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(bugfix);
+}
+
+std::string eigenVersion() {
+  return std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." + std::to_string(EIGEN_MINOR_VERSION);
+}
+
 }  // namespace articula::fit

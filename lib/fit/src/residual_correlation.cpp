@@ -21,34 +21,39 @@ struct Bin {
 
 // gamma(h) = c0 + c1 (1 - exp(-h/L1)) + c2 (1 - exp(-h/L2)) for given lengths:
 // non-negative weighted least squares (every subset of the three terms
-// solved free, the best with no negative coefficient kept); returns the
-// weighted residual, or infinity.
+// solved free from the 3 x 3 normal equations, the best with no negative
+// coefficient kept); returns the weighted residual, or infinity.
 double fitAtLengths(const std::vector<double>& h, const std::vector<double>& gamma, const std::vector<double>& weight,
                     double l1, double l2, Eigen::Vector3d& c) {
-  const auto bins = static_cast<Eigen::Index>(h.size());
-  Eigen::MatrixXd X(bins, 3);
-  Eigen::VectorXd y(bins), w(bins);
-  for (Eigen::Index k = 0; k < bins; ++k) {
-    X.row(k) << 1.0, 1.0 - std::exp(-h[static_cast<size_t>(k)] / l1), 1.0 - std::exp(-h[static_cast<size_t>(k)] / l2);
-    y[k] = gamma[static_cast<size_t>(k)];
-    w[k] = weight[static_cast<size_t>(k)];
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  double yy = 0;
+  for (size_t k = 0; k < h.size(); ++k) {
+    const Eigen::Vector3d x(1.0, 1.0 - std::exp(-h[k] / l1), 1.0 - std::exp(-h[k] / l2));
+    normal += weight[k] * x * x.transpose();
+    rhs += weight[k] * gamma[k] * x;
+    yy += weight[k] * gamma[k] * gamma[k];
   }
   double best = INFINITY;
   for (int subset = 1; subset < 8; ++subset) {
-    std::vector<Eigen::Index> cols;
-    for (Eigen::Index j = 0; j < 3; ++j)
-      if (subset & (1 << j)) cols.push_back(j);
-    const auto q = static_cast<Eigen::Index>(cols.size());
-    Eigen::MatrixXd A(bins, q);
-    for (Eigen::Index j = 0; j < q; ++j) A.col(j) = X.col(cols[static_cast<size_t>(j)]);
-    const Eigen::MatrixXd normal = A.transpose() * w.asDiagonal() * A;
-    const Eigen::VectorXd solution = normal.ldlt().solve(A.transpose() * w.asDiagonal() * y);
-    if (!solution.allFinite() || solution.minCoeff() < 0) continue;
-    const double sse = (w.array() * (y - A * solution).array().square()).sum();
+    int cols[3], q = 0;
+    for (int j = 0; j < 3; ++j)
+      if (subset & (1 << j)) cols[q++] = j;
+    Eigen::Matrix3d n = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (int i = 0; i < q; ++i) {
+      b[i] = rhs[cols[i]];
+      for (int j = 0; j < q; ++j) n(i, j) = normal(cols[i], cols[j]);
+    }
+    const Eigen::Vector3d solution = n.ldlt().solve(b);
+    if (!solution.allFinite() || solution.head(q).minCoeff() < 0) continue;
+    Eigen::Vector3d full = Eigen::Vector3d::Zero();
+    for (int i = 0; i < q; ++i) full[cols[i]] = solution[i];
+    // sum w (y - X c)^2 = y'Wy - 2 c'X'Wy + c'X'WXc.
+    const double sse = yy - 2.0 * full.dot(rhs) + full.dot(normal * full);
     if (sse < best) {
       best = sse;
-      c.setZero();
-      for (Eigen::Index j = 0; j < q; ++j) c[cols[static_cast<size_t>(j)]] = solution[j];
+      c = full;
     }
   }
   return best;

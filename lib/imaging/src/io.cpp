@@ -15,6 +15,7 @@
 #include <gdcmUIDGenerator.h>
 #include <itkGDCMImageIO.h>
 #include <itkImage.h>
+#include <itkVersion.h>
 #include <itkMultiThreaderBase.h>
 #include <cerrno>
 #include <cstdint>
@@ -714,5 +715,7 @@ void writeDicomSeries(const fs::path& folder, const Volume& volume, const std::s
     throw InputError("could not write the DICOM series to " + folder.string() + ": " + e.GetDescription());
   }
 }
+
+std::string itkVersion() { return itk::Version::GetITKVersion(); }
 
 }  // namespace articula::imaging

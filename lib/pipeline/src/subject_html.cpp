@@ -250,7 +250,12 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
   std::ostringstream p;
   p << "The " << results.value("side", "") << " " << (results.value("joint", "") == "shoulder" ? "humeral" : "femoral")
     << " head was analysed with articula " << text(provenance, "articula_version") << " (commit "
-    << text(provenance, "git_commit") << "). ";
+    << text(provenance, "git_commit") << ")";
+  std::string libraries;
+  for (const auto& [name, version] : member(results, "libraries").items())
+    libraries += (libraries.empty() ? "" : ", ") + name + " " + (version.is_string() ? version.get<std::string>() : "");
+  if (!libraries.empty()) p << ", built on " << libraries;
+  p << ". ";
   const std::string seed_source = text(segment, "seed_source");
   p << "It was segmented from the CT " << (seed_source.rfind("automatic", 0) == 0 ? "automatically (a search for the "
                                                                                      "joint head, then a marker watershed)"
@@ -289,8 +294,21 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
       << fixed(numberAt(parameters, "t1_mm"), 1) << ", " << fixed(numberAt(parameters, "t2_mm"), 1) << ", "
       << fixed(numberAt(parameters, "t3_mm"), 1) << ") mm (LPS)";
   }
-  const std::string status = text(member(results, "qc"), "status");
-  p << ". The result's checks were " << (status.empty() ? "not run" : status) << ".";
+  p << ". The shape models, their fitting hierarchy and the signed Euclidean errors follow the thesis \"Smooth convex "
+       "surfaces for modeling and simulating multibody systems with compliant contact elements\" (chapters 2-3).";
+  // The checks as a sentence: which warned or failed, by name.
+  const json& qc = member(results, "qc");
+  std::string warned, failed;
+  for (const auto& c : member(qc, "checks")) {
+    std::string& list = text(c, "status") == "fail" ? failed : warned;
+    if (text(c, "status") != "pass") list += (list.empty() ? "" : ", ") + text(c, "name");
+  }
+  const std::string status = text(qc, "status");
+  if (status.empty()) p << " The head's checks were not run.";
+  else if (status == "pass") p << " Every check of the head passed.";
+  else
+    p << (failed.empty() ? "" : " The head failed its checks (" + failed + ").")
+      << (warned.empty() ? "" : " Checks that warned: " + warned + ".");
   return p.str();
 }
 

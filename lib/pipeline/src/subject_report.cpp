@@ -30,6 +30,8 @@
 #include "articula/pipeline/statistics.hpp"
 #include "articula/pipeline/subject_html.hpp"
 #include "articula/points/mesh_file.hpp"
+#include "articula/sampling/select.hpp"
+#include "articula/fit/fit_hierarchy.hpp"
 #include "articula/points/point_io.hpp"
 #include "articula/report/error_map_svg.hpp"
 #include "articula/report/markup_text.hpp"
@@ -402,6 +404,12 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"head_center_mm", {c[0], c[1], c[2]}},
       {"qc", qc.toJson()},
       {"cap_departures", departures ? departures->toJson() : json(nullptr)},
+      {"libraries",
+       {{"ITK", imaging::itkVersion()},
+        {"VTK", points::vtkLibraryVersion()},
+        {"CGAL", sampling::cgalVersion()},
+        {"NLopt", fit::nloptVersion()},
+        {"Eigen", fit::eigenVersion()}}},
       {"models", models},
       {"coordinate_system", "LPS"},
       {"units", "mm"},

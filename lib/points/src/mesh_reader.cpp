@@ -1,6 +1,7 @@
 // Meshes (.stl, .obj, .vtp, .vtk, .ply) through VTK's readers. VTK reports problems through
 // error events rather than exceptions, so an observer on the reader, its executive and (for XML)
 // its parser collects them, keeps them off stderr, and we throw InputError with the first one.
+#include <vtkVersion.h>
 #include <vtkAlgorithm.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
@@ -279,5 +280,7 @@ MeshFile meshFromPolyData(vtkPolyData* poly) {
   }
   return out;
 }
+
+std::string vtkLibraryVersion() { return vtkVersion::GetVTKVersion(); }
 
 }  // namespace articula::points

@@ -10,6 +10,7 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Random.h>
+#include <CGAL/version.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
 #include <CGAL/property_map.h>
 
@@ -256,5 +257,9 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
                      std::to_string(o.min_points) + " to fit a surface");
   return sel;
 }
+
+#define ARTICULA_STRINGIFY_VALUE(x) ARTICULA_STRINGIFY(x)
+#define ARTICULA_STRINGIFY(x) #x
+std::string cgalVersion() { return ARTICULA_STRINGIFY_VALUE(CGAL_VERSION); }  // CGAL_VERSION is a bare 5.5.1
 
 }  // namespace articula::sampling

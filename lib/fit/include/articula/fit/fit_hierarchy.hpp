@@ -112,4 +112,8 @@ ModelFit fitFrom(const geometry::ShapeParameters& start, const Eigen::MatrixX3d&
 double algebraicObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
 double geometricObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
 
+/// The NLopt and Eigen versions this build fits with.
+std::string nloptVersion();
+std::string eigenVersion();
+
 }  // namespace articula::fit

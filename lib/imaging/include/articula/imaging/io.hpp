@@ -95,4 +95,7 @@ void writeDicomSeries(const std::filesystem::path& folder, const Volume& volume,
 /// Throws InputError unless `direction` is orthonormal within 1e-3.
 void checkDirection(const Eigen::Matrix3d& direction, const std::string& where);
 
+/// The ITK version this build reads and segments with (methods text, provenance).
+std::string itkVersion();
+
 }  // namespace articula::imaging

@@ -5,6 +5,7 @@
 // mesh stage's input and the vertices a point file may be. Eigen out, VTK
 // stays inside lib/points.
 #include <filesystem>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -19,5 +20,8 @@ struct MeshFile {
 /// Reads a mesh by extension (case-insensitive). Throws InputError naming
 /// the file: missing, another extension, VTK's first error, no vertices.
 MeshFile readMeshFile(const std::filesystem::path& path);
+
+/// The VTK version this build meshes and reads surfaces with.
+std::string vtkLibraryVersion();
 
 }  // namespace articula::points

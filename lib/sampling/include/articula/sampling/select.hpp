@@ -46,4 +46,7 @@ struct Selection {
 Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
                           const SelectOptions& options);
 
+/// The CGAL version this build selects articular surfaces with.
+std::string cgalVersion();
+
 }  // namespace articula::sampling
