@@ -41,7 +41,7 @@ class MeshCommand : public cli::Command {
                    "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
                    "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
                    "the voxels about the normal, with one point-spread for the CT; 'auto' the cortex model on CTs "
-                   "whose voxels are at most 0.8 mm on every side, the steepest fall beyond")
+                   "whose voxels are at most 1 mm within the slices and 3 mm across them, the steepest fall beyond")
         ->check(CLI::IsMember({"auto", "cortex", "steepest"}))
         ->capture_default_str();
     app.add_option("--point-spread", snap_.point_spread_mm,
@@ -94,6 +94,7 @@ class MeshCommand : public cli::Command {
                {"slice_point_spread_mm", snapped.slice_point_spread_mm},
                {"point_spread_estimated", snapped.point_spread_estimated},
                {"point_spread_applied", snapped.point_spread_on_voxel_grid ? "voxel_grid" : "scanner"},
+               {"cortex_held_across_slices", snapped.cortex_held_across_slices},
                {"vertices_on_cortex_model", snapped.on_cortex_model},
                {"mean_model_shift_mm", snapped.mean_model_shift_mm}};
       if (!snapped.cortex_model_note.empty()) {

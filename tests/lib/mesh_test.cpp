@@ -157,6 +157,38 @@ TEST(Mesh, ThinCortexSurfaceOnTheTrueHeadAtFineVoxels) {
   EXPECT_LT(std::abs(mean[1]), 0.5 * mean[0]);
 }
 
+// At clinical voxels (1 x 1 x 2 mm) the same thin cortex pulls the steepest
+// fall 0.3 mm outwards, twice that on the lines across the slices. The
+// automatic edge model is the blurred-cortex model there too: the lines
+// across the slices hold the cortex told by the lines within them, and the
+// head's surface lies within 0.05 mm of the true one on average.
+TEST(Mesh, ThinCortexSurfaceOnTheTrueHeadAtClinicalVoxels) {
+  phantom::PhantomOptions o;
+  o.seed = 12;
+  o.model = geometry::ShapeModel::Sphere;
+  o.spacing = Eigen::Vector3d(1.0, 1.0, 2.0);
+  o.exact_depth = true;
+  o.head_radius_mm = 21;
+  o.makeOsteoporotic();
+  const phantom::Phantom p = phantom::makePhantom(o);
+  const mesh::TriangleMesh label_surface = mesh::extractSurface(imaging::segmentHead(p.ct, {}), {});
+  double mean[2] = {0, 0};
+  for (const mesh::EdgeModel model : {mesh::EdgeModel::SteepestFall, mesh::EdgeModel::Automatic}) {
+    mesh::TriangleMesh m = label_surface;
+    mesh::EdgeSnapOptions snap;
+    snap.edge_model = model;
+    mesh::EdgeSnapSummary summary;
+    mesh::snapToEdges(m, p.ct, snap, &summary);
+    ASSERT_TRUE(summary.moved);
+    EXPECT_EQ(summary.cortex_model, model == mesh::EdgeModel::Automatic);
+    const SurfaceError e = headSurfaceError(p, m);
+    EXPECT_GT(e.vertices, 500);
+    mean[model == mesh::EdgeModel::Automatic] = e.mean_mm;
+  }
+  EXPECT_GT(mean[0], 0.2) << "the steepest fall's outward pull";
+  EXPECT_NEAR(mean[1], 0.0, 0.05) << "the cortex model's surface";
+}
+
 TEST(Mesh, EmptyLabelIsAnInputError) {
   imaging::Label label;
   label.geometry.size = Eigen::Vector3i(4, 4, 4);
