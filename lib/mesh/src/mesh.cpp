@@ -247,19 +247,35 @@ namespace {
 /// bone window cuts it millimetres inside its edge); with `look_further`,
 /// the first fall met going out within 3 mm (1.5 voxels) is taken then, if
 /// the way to it stays in bone (above the middle of that fall), so that a
-/// socket's cortex beyond a joint gap is never taken.
+/// socket's cortex beyond a joint gap is never taken. Where the window holds
+/// no fall at all, the label may also end outside the bone: a flattened or
+/// eroded dome whose gap to the socket the segmentation's closing bridged
+/// (the label keeps the round head there, up to a quarter of its radius
+/// above the bone). The first fall met going out from kLabelOutsideReachMm
+/// inside is taken then, if the way from it to x stays out of bone (below
+/// the middle of that fall), so that no edge within the bone is taken.
 imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, const Eigen::Vector3d& u,
                        const imaging::EdgeSearch& search, bool look_further) {
+  constexpr double kLabelOutsideReachMm = 7.0;
   const imaging::Edge e = imaging::locateEdge(ct, x, u, search);
   if (!look_further || (e.found && e.offset_mm <= search.outward_mm - 0.15)) return e;
   const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
   imaging::Edge further = imaging::firstEdgeAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
   further.offset_mm -= search.inward_mm;
-  if (!further.found || (e.found && further.offset_mm <= e.offset_mm)) return e;
-  const double middle = 0.5 * (further.inside_hu + further.outside_hu);
-  for (double t = 0; t <= further.offset_mm - 0.5; t += 0.1)
-    if (!(imaging::interpolate(ct, x + t * u) >= middle)) return e;
-  return further;
+  if (further.found && !(e.found && further.offset_mm <= e.offset_mm)) {
+    const double middle = 0.5 * (further.inside_hu + further.outside_hu);
+    for (double t = 0; t <= further.offset_mm - 0.5; t += 0.1)
+      if (!(imaging::interpolate(ct, x + t * u) >= middle)) return e;
+    return further;
+  }
+  if (e.found) return e;
+  imaging::Edge below = imaging::firstEdgeAlongRay(ct, x - kLabelOutsideReachMm * u, u, 0.0, kLabelOutsideReachMm, search);
+  below.offset_mm -= kLabelOutsideReachMm;
+  if (!below.found || below.offset_mm > -search.inward_mm) return e;
+  const double middle = 0.5 * (below.inside_hu + below.outside_hu);
+  for (double t = below.offset_mm + 0.5; t <= 0; t += 0.1)
+    if (!(imaging::interpolate(ct, x + t * u) < middle)) return e;
+  return below;
 }
 
 /// Neighbour averages over the triangles' edges: the found shifts smoothed
