@@ -40,6 +40,32 @@ SurfaceError headSurfaceError(const phantom::Phantom& p, const mesh::TriangleMes
           signed_sum / std::max(count, 1)};
 }
 
+// The head's surface from the phantom's segmented label moved onto the CT's
+// edges by the steepest fall alone (mean_mm[0]) and by the automatic edge
+// model (mean_mm[1]), which is the blurred-cortex model on these voxels.
+struct EdgeModelComparison {
+  double mean_mm[2] = {0, 0};
+  mesh::EdgeSnapSummary automatic;
+};
+EdgeModelComparison compareEdgeModels(const phantom::Phantom& p, int min_vertices) {
+  const mesh::TriangleMesh label_surface = mesh::extractSurface(imaging::segmentHead(p.ct, {}), {});
+  EdgeModelComparison c;
+  for (const mesh::EdgeModel model : {mesh::EdgeModel::SteepestFall, mesh::EdgeModel::Automatic}) {
+    mesh::TriangleMesh m = label_surface;
+    mesh::EdgeSnapOptions snap;
+    snap.edge_model = model;
+    mesh::EdgeSnapSummary summary;
+    mesh::snapToEdges(m, p.ct, snap, &summary);
+    EXPECT_TRUE(summary.moved);
+    EXPECT_EQ(summary.cortex_model, model == mesh::EdgeModel::Automatic);
+    const SurfaceError e = headSurfaceError(p, m);
+    EXPECT_GT(e.vertices, min_vertices);
+    c.mean_mm[model == mesh::EdgeModel::Automatic] = e.mean_mm;
+    if (model == mesh::EdgeModel::Automatic) c.automatic = summary;
+  }
+  return c;
+}
+
 TEST(Mesh, FemurSurfaceLiesOnTrueHeadInLpsForLpsAndRasGrids) {
   for (bool ras : {false, true}) {
     phantom::PhantomOptions o;
@@ -133,24 +159,10 @@ TEST(Mesh, ThinCortexSurfaceOnTheTrueHeadAtFineVoxels) {
   o.head_radius_mm = 18;
   o.makeOsteoporotic();
   const phantom::Phantom p = phantom::makePhantom(o);
-  const mesh::TriangleMesh label_surface = mesh::extractSurface(imaging::segmentHead(p.ct, {}), {});
-  double mean[2] = {0, 0};
-  for (const mesh::EdgeModel model : {mesh::EdgeModel::SteepestFall, mesh::EdgeModel::Automatic}) {
-    mesh::TriangleMesh m = label_surface;
-    mesh::EdgeSnapOptions snap;
-    snap.edge_model = model;
-    mesh::EdgeSnapSummary summary;
-    mesh::snapToEdges(m, p.ct, snap, &summary);
-    ASSERT_TRUE(summary.moved);
-    EXPECT_EQ(summary.cortex_model, model == mesh::EdgeModel::Automatic);
-    const SurfaceError e = headSurfaceError(p, m);
-    EXPECT_GT(e.vertices, 2000);
-    mean[model == mesh::EdgeModel::Automatic] = e.mean_mm;
-    if (model == mesh::EdgeModel::Automatic) {
-      EXPECT_NEAR(summary.point_spread_mm, o.blur_mm, 0.05);
-      EXPECT_NEAR(summary.slice_point_spread_mm, o.blur_mm, 0.05);
-    }
-  }
+  const EdgeModelComparison c = compareEdgeModels(p, 2000);
+  const double* mean = c.mean_mm;
+  EXPECT_NEAR(c.automatic.point_spread_mm, o.blur_mm, 0.05);
+  EXPECT_NEAR(c.automatic.slice_point_spread_mm, o.blur_mm, 0.05);
   EXPECT_GT(mean[0], 0.12) << "the steepest fall's outward pull";
   // The model's surface moves about 3.5 mm per mm of point-spread error:
   // a few hundredths of a millimetre (this phantom) put it 0.06 mm inside.
@@ -172,20 +184,7 @@ TEST(Mesh, ThinCortexSurfaceOnTheTrueHeadAtClinicalVoxels) {
   o.head_radius_mm = 21;
   o.makeOsteoporotic();
   const phantom::Phantom p = phantom::makePhantom(o);
-  const mesh::TriangleMesh label_surface = mesh::extractSurface(imaging::segmentHead(p.ct, {}), {});
-  double mean[2] = {0, 0};
-  for (const mesh::EdgeModel model : {mesh::EdgeModel::SteepestFall, mesh::EdgeModel::Automatic}) {
-    mesh::TriangleMesh m = label_surface;
-    mesh::EdgeSnapOptions snap;
-    snap.edge_model = model;
-    mesh::EdgeSnapSummary summary;
-    mesh::snapToEdges(m, p.ct, snap, &summary);
-    ASSERT_TRUE(summary.moved);
-    EXPECT_EQ(summary.cortex_model, model == mesh::EdgeModel::Automatic);
-    const SurfaceError e = headSurfaceError(p, m);
-    EXPECT_GT(e.vertices, 500);
-    mean[model == mesh::EdgeModel::Automatic] = e.mean_mm;
-  }
+  const double* mean = compareEdgeModels(p, 500).mean_mm;
   EXPECT_GT(mean[0], 0.2) << "the steepest fall's outward pull";
   EXPECT_NEAR(mean[1], 0.0, 0.05) << "the cortex model's surface";
 }
