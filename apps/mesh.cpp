@@ -70,6 +70,7 @@ class MeshCommand : public cli::Command {
                {"slice_point_spread_mm", snapped.slice_point_spread_mm},
                {"point_spread_estimated", snapped.point_spread_estimated},
                {"point_spread_applied", snapped.point_spread_on_voxel_grid ? "voxel_grid" : "scanner"},
+               {"cortex_held_across_slices", snapped.cortex_held_across_slices},
                {"vertices_on_cortex_model", snapped.on_cortex_model},
                {"mean_model_shift_mm", snapped.mean_model_shift_mm}};
       if (!snapped.cortex_model_note.empty()) {

@@ -26,6 +26,7 @@ double Phi(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 /// it meet the voxels at every phase.
 struct FlatCortex {
   double soft = 40, cortical = 700, cancellous = 190, thickness = 0.8, sigma = 0.5, spacing = 0.7, noise = 20;
+  double slice_spacing = 0;  // along the grid's third axis (0: `spacing`)
   double surface = 0.23;
   Eigen::Vector3d n = Eigen::Vector3d(1, 0.21, -0.13).normalized();
   Eigen::Vector3i size = Eigen::Vector3i(24, 40, 40);  // voxels (the grid centred on the origin)
@@ -53,22 +54,26 @@ struct FlatCortex {
             (socket_cortical - socket_cancellous) * Phi((d - gap - socket_thickness) / sigma);
     return hu;
   }
-  /// A voxel: the blurred profile averaged over 5 x 5 x 5 points of it (partial volume).
+  Eigen::Vector3d spacings() const {
+    return Eigen::Vector3d(spacing, spacing, slice_spacing > 0 ? slice_spacing : spacing);
+  }
+  /// A voxel: the blurred profile averaged over 5 x 5 x 5 points of it
+  /// (partial volume; 5 x 5 x 15 across long slices).
   double voxel(const Eigen::Vector3d& centre) const {
-    constexpr int kSub = 5;
+    const int sub = 5, sub_z = spacings().z() > 2 * spacing ? 15 : 5;
     double sum = 0;
-    for (int c = 0; c < kSub * kSub * kSub; ++c) {
-      const Eigen::Vector3d offset((c % kSub + 0.5) / kSub - 0.5, (c / kSub % kSub + 0.5) / kSub - 0.5,
-                                   (c / (kSub * kSub) + 0.5) / kSub - 0.5);
-      sum += blurred(n.dot(centre + spacing * offset) - surface);
+    for (int c = 0; c < sub * sub * sub_z; ++c) {
+      const Eigen::Vector3d offset((c % sub + 0.5) / sub - 0.5, (c / sub % sub + 0.5) / sub - 0.5,
+                                   (c / (sub * sub) + 0.5) / sub_z - 0.5);
+      sum += blurred(n.dot(centre + spacings().cwiseProduct(offset)) - surface);
     }
-    return sum / (kSub * kSub * kSub);
+    return sum / (sub * sub * sub_z);
   }
   imaging::Volume volume(unsigned seed) const {
     imaging::Volume v;
     v.geometry.size = size;
-    v.geometry.spacing = Eigen::Vector3d::Constant(spacing);
-    v.geometry.origin = -0.5 * spacing * (size.cast<double>() - Eigen::Vector3d::Ones());
+    v.geometry.spacing = spacings();
+    v.geometry.origin = -0.5 * spacings().cwiseProduct(size.cast<double>() - Eigen::Vector3d::Ones());
     v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise_hu(0.0, noise);
@@ -107,7 +112,8 @@ struct FlatCortex {
 };
 
 /// Lines across the plane at many places, each started on the steepest
-/// fall as the mesh stage starts them (`starts`: that fall's offset).
+/// fall as the mesh stage starts them (`starts`: that fall's offset), with
+/// the mesh stage's window and radius for the line's direction.
 std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed, std::vector<double>& starts) {
   const imaging::Volume v = c.volume(seed);
   const Eigen::Vector3d u = c.n;
@@ -119,8 +125,10 @@ std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed,
       const imaging::Edge edge = imaging::locateEdge(v, x0, u, {});
       if (!edge.found) continue;
       starts.push_back(edge.offset_mm);
-      lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm,
-                                               imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry)));
+      const Eigen::Vector3d axis_step = v.geometry.spacing.cwiseProduct(u);
+      const double further_in = imaging::cortexSearchMm(axis_step) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
+      lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm - further_in,
+                                               imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry, u)));
     }
   return lines;
 }
@@ -306,6 +314,51 @@ TEST(CortexEdge, ResidualIsTheBestMetWhereTheSearchEndsEarly) {
     }
     previous = residual;
   }
+}
+
+// Across 3 mm slices (0.8 mm within them) a thin cortex's thickness trades
+// against the blur along the line, three voxels' worth of the slice's
+// extent: fitted freely, at the true point-spread, the lines take an 0.8 mm
+// cortex for 2-3 mm and leave the surface 0.7 mm out, on the steepest fall.
+// Held to the cortex that lines within the slices show
+// (imaging::CortexTissue), each line's surface is where it is.
+TEST(CortexEdge, ThinCortexAcrossLongSlicesHeldToItsTissue) {
+  FlatCortex across;
+  across.spacing = 0.8;
+  across.slice_spacing = 3.0;
+  across.n = Eigen::Vector3d(0.3, 0.1, 1).normalized();  // a slice share of 0.91
+  across.across1 = across.n.unitOrthogonal();
+  across.across2 = across.n.cross(across.across1);
+  across.size = Eigen::Vector3i(44, 44, 12);
+  std::vector<double> starts;
+  const std::vector<imaging::LineVoxels> lines = linesAcross(across, 21, starts);
+  ASSERT_GT(lines.size(), 100U);
+  imaging::PointSpread spread;
+  spread.sigma_mm = spread.slice_sigma_mm = across.sigma;
+  imaging::CortexTissue tissue;
+  tissue.thickness_mm = across.thickness;
+  tissue.outside_hu = across.soft;
+  tissue.cortex_hu = across.cortical;
+  tissue.inside_hu = across.cancellous;
+  double free_sum = 0, held_sum = 0, steepest = 0;
+  int free_found = 0, held_found = 0;
+  std::vector<double> thickness;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const imaging::StepResponse response(lines[i], spread);
+    const imaging::CortexFit free = imaging::fitCortex(lines[i], 0.0, response);
+    const imaging::CortexFit held = imaging::fitCortex(lines[i], 0.0, response, 150, &tissue);
+    steepest += starts[i] / static_cast<double>(lines.size());
+    if (free.found) free_sum += starts[i] + free.offset_mm, ++free_found, thickness.push_back(free.thickness_mm);
+    if (held.found) held_sum += starts[i] + held.offset_mm, ++held_found;
+    EXPECT_EQ(held.thickness_mm, across.thickness);
+  }
+  EXPECT_GT(steepest, 0.5) << "the steepest fall's outward pull across the slices";
+  ASSERT_GT(free_found, 100);
+  std::sort(thickness.begin(), thickness.end());
+  EXPECT_GT(thickness[thickness.size() / 2], 1.5) << "the free fits' median thickness";
+  EXPECT_GT(free_sum / free_found, 0.5) << "fitted freely";
+  ASSERT_GT(held_found, 100);
+  EXPECT_NEAR(held_sum / held_found, 0.0, 0.05) << "held to the cortex's tissue";
 }
 
 TEST(CortexEdge, NothingFoundWithoutABrightLayerOrVoxels) {

@@ -232,7 +232,13 @@ TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
                         {"bic", -90.0 * (m + 1)}});
     fs::create_directories(p::subjectDir(dir, ids[i]));
     write(p::subjectDir(dir, ids[i]) / "results.json",
-          nlohmann::json({{"best_model", "ellipsoid"}, {"models", models}}).dump());
+          nlohmann::json({{"best_model", "ellipsoid"},
+                          {"selected_model", "sphere"},
+                          {"joint", "hip"},
+                          {"side", i ? "left" : "right"},
+                          {"qc", {{"status", i ? "warn" : "pass"}, {"reasons", {"a check warned"}}}},
+                          {"models", models}})
+              .dump());
   }
   p::writeStudyTables(dir, subjects, batch, nlohmann::json::object());
   std::ifstream in(dir / "study.svg");
@@ -245,6 +251,23 @@ TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
   EXPECT_TRUE(has("across 2 subjects"));
   EXPECT_FALSE(has("bad"));
   EXPECT_LT(svg.find("<title>s2 sphere"), svg.find("<title>s1 sphere"));  // manifest order
+
+  // study.html: a lane per joint and side, the flagged subject ringed and
+  // named, the per-model table, and the bound two subjects put on the
+  // signed-rank test (2 / 2^2 = 0.5, the smallest p they can give).
+  std::ifstream page_in(dir / "study.html");
+  const std::string page((std::istreambuf_iterator<char>(page_in)), std::istreambuf_iterator<char>());
+  auto on_page = [&](const std::string& s) { return page.find(s) != std::string::npos; };
+  EXPECT_TRUE(on_page("<text class=\"lane\" x=\"4\" y=\"54\">hip, right</text>"));
+  EXPECT_TRUE(on_page("<text class=\"lane\" x=\"4\" y=\"98\">hip, left</text>"));
+  EXPECT_TRUE(on_page("<title>s1: 0.3 mm (checks: warn)</title>"));
+  EXPECT_TRUE(on_page("<title>s2: 0.5 mm</title>"));
+  EXPECT_FALSE(on_page("s2: 0.5 mm (checks"));
+  EXPECT_TRUE(on_page("<tr><td>ellipsoid</td><td>2</td><td>0.150 &plusmn; 0.071</td><td>0</td><td>0</td><td>0.5 (n = 2) *</td></tr>"))
+      << page.substr(page.find("model-summary"), 800);
+  EXPECT_TRUE(on_page("id=\"small-sample\""));
+  EXPECT_TRUE(on_page("<tr class=\"warn\"><td><a href=\"subjects/s1/run.log\">s1</a></td><td>checks: warn</td><td>a check warned</td></tr>") ||
+              on_page("<tr class=\"warn\"><td>s1</td><td>checks: warn</td><td>a check warned</td></tr>"));
 }
 
 namespace articula {

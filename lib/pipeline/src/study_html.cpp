@@ -57,7 +57,9 @@ std::string plots(const std::vector<std::pair<std::string, json>>& results, cons
       } else if (m) {
         v = numberAt(member(*m, "parameters"), q.parameter);
       }
-      points.push_back({id, v, subjectLink(study_dir, id)});
+      const std::string status = text(member(r, "qc"), "status");
+      points.push_back({id, v, subjectLink(study_dir, id), text(r, "joint") + ", " + text(r, "side"),
+                        status == "warn" || status == "fail" ? status : ""});
     }
     html += "<figure>" + report::stripPlotSvg(q.title, q.unit, points) + "</figure>\n";
   }
@@ -84,6 +86,42 @@ std::string cohortSteps(const json& study) {
                 "any subject needs the richer model and is carried by single extreme subjects; the sign test asks "
                 "whether a majority does and cannot fall below 0.05 with fewer than 5 subjects. Both take the subjects "
                 "as independent.</p>\n";
+}
+
+// Per model over the cohort (study.json "models"): mean RMS, how often it is
+// selected and has the least RMS, and the paired test of its RMS against the
+// sphere's, with the smallest p its number of subjects can give.
+std::string modelSummary(const json& study) {
+  std::string html = "<table id=\"model-summary\"><tr><th>model</th><th>subjects</th><th>RMS mean &plusmn; SD (mm)</th>"
+                     "<th>selected</th><th>least RMS</th><th>Wilcoxon p, RMS against the sphere's</th></tr>\n";
+  bool bound = false;
+  for (const auto& m : member(study, "models")) {
+    char rms[64];
+    std::snprintf(rms, sizeof rms, "%.3f &plusmn; %.3f", numberAt(m, "rms_mean_mm"), numberAt(m, "rms_sd_mm"));
+    std::string p = "-";
+    const json& w = member(m, "wilcoxon_vs_sphere");
+    if (w.is_object() && w.contains("p_value")) {
+      const int n = static_cast<int>(numberAt(w, "n"));
+      // Two-sided exact signed-rank test: no p below 2 / 2^n with n pairs.
+      const double smallest = n > 0 && n < 1000 ? std::ldexp(2.0, -n) : 0.0;
+      char buffer[96];
+      std::snprintf(buffer, sizeof buffer, "%.3g (n = %d)", numberAt(w, "p_value"), n);
+      p = buffer;
+      if (smallest > 0 && numberAt(w, "p_value") <= smallest * (1 + 1e-9)) {
+        p += " *";
+        bound = true;
+      }
+    }
+    html += "<tr><td>" + escapeMarkup(text(m, "model")) + "</td><td>" + text(m, "n_subjects") + "</td><td>" + rms +
+            "</td><td>" + text(m, "times_selected") + "</td><td>" + text(m, "times_least_rms") + "</td><td>" + p +
+            "</td></tr>\n";
+  }
+  html += "</table>\n";
+  if (bound)
+    html += "<p class=\"note\" id=\"small-sample\">* the smallest p this number of subjects can give (2 / 2<sup>n</sup>): "
+            "the test cannot say more with so few subjects.</p>\n";
+  return html + "<p class=\"note\">A richer model always fits with less RMS; whether a subject needs it is its "
+                "nested test (the hierarchy's table below), not this difference.</p>\n";
 }
 
 std::string selectedModels(const std::vector<std::pair<std::string, json>>& results, const fs::path& study_dir,
@@ -204,9 +242,9 @@ std::string studyReportHtml(const json& study, const std::vector<std::pair<std::
        << numberAt(study, "failed") << "</span> failed, <span id=\"flagged\">" << flagged
        << "</span> flagged by their checks, <span id=\"excluded-count\">" << numberAt(study, "excluded")
        << "</span> excluded by the reviewer.</p>\n<section id=\"look\"><h2>Subjects to look at</h2>\n" << look
-       << "</section>\n<section id=\"quantities\"><h2>Across the subjects</h2>\n<p class=\"note\">A dot per subject; a "
-          "click opens its page.</p>\n"
-       << plots(results, study_dir, models) << "<h3>Selected models</h3>\n<div class=\"scroll\">" << selectedModels(results, study_dir, models) << "</div>\n"
+       << "</section>\n<section id=\"quantities\"><h2>Across the subjects</h2>\n<p class=\"note\">A dot per subject, a lane per "
+          "joint and side; ringed, in orange or red, where its checks warned or failed; a click opens its page.</p>\n"
+       << "<h3>Models</h3>\n" << modelSummary(study) << plots(results, study_dir, models) << "<h3>Selected models</h3>\n<div class=\"scroll\">" << selectedModels(results, study_dir, models) << "</div>\n"
        << "<h3>Which steps of the hierarchy the cohort needs</h3>\n" << cohortSteps(study)
        << "</section>\n" << reviewSection(subjects) << "<section id=\"tables\"><h2>Tables</h2><ul>";
   for (const char* file : {"study.csv", "study_summary.csv", "study_steps.csv", "study_status.csv", "study.json", "study.svg", "ratings.csv"})

@@ -44,6 +44,7 @@ struct LineVoxels {
   double slice_share = 0;       // (u . slice axis)^2: how far the line runs across the slices
   Eigen::Vector3d spacing_mm = Eigen::Vector3d::Zero();    // the grid's, per axis
   Eigen::Vector3d axis_step_mm = Eigen::Vector3d::Zero();  // how far along u one voxel's step along each grid axis goes
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();      // x: where the line's neighbours are sought
 };
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
                            double to_mm, double radius_mm, double curvature_per_mm = 0);
@@ -52,9 +53,22 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
 /// (the cortex and some cancellous bone) to kCortexOutwardMm outside it (the
 /// joint gap and the near side of a socket).
 constexpr double kCortexInwardMm = 3.5, kCortexOutwardMm = 2.5;
+/// How far either side of its guess a line's surface is sought: a
+/// millimetre, or three quarters of the voxel's extent along the line
+/// where that is more (`axis_step_mm` as in LineVoxels): across 3 mm slices
+/// a thin cortex's steepest fall lies up to 1.5 mm outside it. A line's
+/// window reaches that much further in than kCortexInwardMm.
+double cortexSearchMm(const Eigen::Vector3d& axis_step_mm);
 /// The radius about the line that holds about 50 voxels of the window (at
 /// least 0.8 mm): enough for the model's seven unknowns at any voxel size.
 double lineRadiusFor(const ImageGeometry& geometry);
+/// The radius for a line along `u`: lineRadiusFor(geometry), and where the
+/// slices are long (tissueHeldAcrossSlices), wide enough (up to
+/// kMaxLineRadiusMm) that the voxels of the slices the line crosses lie at
+/// every depth along it: a line near the slice axis meets each slice at one
+/// depth only, and its surface is then told by no voxel.
+double lineRadiusFor(const ImageGeometry& geometry, const Eigen::Vector3d& u);
+constexpr double kMaxLineRadiusMm = 5.0;
 
 struct PointSpread;
 
@@ -78,23 +92,33 @@ class StepResponse {
   std::vector<double> table_;  // the share every kTableStepMm
 };
 
-struct CortexFit {
+/// The bone about a line: its cortex's thickness and the levels of the
+/// soft tissue outside, the cortex and the cancellous bone within.
+struct CortexTissue {
+  double thickness_mm = 0;
+  double outside_hu = 0, cortex_hu = 0, inside_hu = 0;
+};
+
+struct CortexFit : CortexTissue {
   bool found = false;
   double offset_mm = 0;        // the outer (periosteal) surface along u
-  double thickness_mm = 0;     // the cortex
-  double outside_hu = 0, cortex_hu = 0, inside_hu = 0;
-  double sum_squares = 0;      // of the residuals, HU^2
+  double gap_mm = 0;           // to the socket's step beyond it (where the model puts one)
+  double sum_squares = 0;      // of the residuals (and of the held levels' departures, weighted), HU^2
 };
 
 /// The blurred-cortex model fitted to `line` with the steps blurred as
-/// `response` says, the surface searched within 1 mm of `guess_mm`. Where
+/// `response` says, the surface searched within cortexSearchMm of `guess_mm`. Where
 /// the voxels rise again beyond the edge (a socket across a joint gap), the
 /// window ends within that rise.
+/// With `held`, the cortex has the held thickness and its levels are drawn
+/// towards the held ones (each as if a few voxels had shown it): for a line
+/// whose blur is too wide to tell a thin cortex's thickness from its
+/// brightness (across thick slices), the tissue comes from lines that can.
 /// Not found when the fit puts no bright layer on the bone side (cortex or
 /// bone at least `min_contrast_hu` above the outside) or the surface at the
 /// search's end.
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, const StepResponse& response,
-                    double min_contrast_hu = 150);
+                    double min_contrast_hu = 150, const CortexTissue* held = nullptr);
 /// The same with the scanner's Gaussian point-spread `sigma_mm` along the
 /// line (the voxel's extent is added).
 CortexFit fitCortex(const LineVoxels& line, double guess_mm, double sigma_mm, double min_contrast_hu = 150);
@@ -112,6 +136,10 @@ struct PointSpread {
   double sigma_mm = 0;        // within the slices
   double slice_sigma_mm = 0;  // across them (along the slice axis, the grid's third index)
   int profiles = 0;           // lines it was estimated on
+  /// Whether the lines across the slices take the cortex of the lines
+  /// within them (fitCortex's `held`): on long slices (tissueHeldAcrossSlices)
+  /// or a blur across the slices a tenth wider than within them.
+  bool held_across = false;
   /// The width along a line: the Gaussian's spread in its direction.
   double along(const LineVoxels& line) const {
     return std::sqrt(sigma_mm * sigma_mm * (1 - line.slice_share) + slice_sigma_mm * slice_sigma_mm * line.slice_share);
@@ -135,6 +163,27 @@ struct PointSpread {
 /// width's least lies at the end of its range. Lines that hardly cross the
 /// slices (their shares summing to less than a tenth of the lines) give one
 /// width for both.
+/// Where the slices are more than a fifth longer than the in-plane voxel
+/// (tissueHeldAcrossSlices), or the width across them comes out more than a
+/// tenth wider than within them, the width across the slices is then
+/// estimated again on the lines across them (slice share kWithinSlicesShare
+/// or more), each fitted with the tissue of its nearest lines within the
+/// slices (nearbyTissue): across long or thick slices a thin cortex's
+/// thickness trades against the blur, and the width with it (held_across).
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
+
+/// Lines whose slice share is below this lie within the slices: across
+/// them a line sees the in-plane voxel's extent and blur only.
+constexpr double kWithinSlicesShare = 0.05;
+/// Whether the voxels are long enough across the slices for the lines
+/// across them to take their tissue from the lines within them.
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm);
+/// ... or whose point-spread is a tenth wider across the slices than within them.
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm, double sigma_mm, double slice_sigma_mm);
+/// For each of `points`, the median tissue of its nearest (15) `known`
+/// tissues (at `known_points`).
+std::vector<CortexTissue> nearbyTissue(const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<Eigen::Vector3d>& known_points,
+                                       const std::vector<CortexTissue>& known);
 
 }  // namespace articula::imaging

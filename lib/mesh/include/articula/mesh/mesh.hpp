@@ -45,14 +45,14 @@ TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& opti
 
 enum class EdgeModel { Automatic, SteepestFall, Cortex };
 
-/// The coarsest voxel (its longest side, mm) on which the automatic edge
-/// model is the blurred-cortex model. Up to it the model's point-spread,
-/// estimated from the CT, put every head of the phantom matrix within
-/// 0.04 mm of its true surface, thin cortices included (the steepest fall:
-/// up to 0.2 mm outside); at 1 x 1 x 1.25 mm it took one CT's point-spread
-/// 0.1 mm wide and the surface 0.2 mm inside, where the steepest fall errs
-/// by less than 0.1 mm (docs/benchmarks.md, "Blurred-cortex edges").
-constexpr double kCortexModelMaxVoxelMm = 0.8;
+/// The coarsest voxels on which the automatic edge model is the
+/// blurred-cortex model: in-plane voxels up to kCortexModelMaxInPlaneMm and
+/// slices up to kCortexModelMaxSliceMm. There the model's surface lay within
+/// 0.05 mm of the true one on average on 65 of 84 heads of three phantom
+/// generators and within 0.1 mm on 82, thin cortices included, where the
+/// steepest fall lay 0.04-0.42 mm outside (docs/benchmarks.md, "Surface bias
+/// by voxel size"); on coarser in-plane voxels (1.5 mm) it is not measured.
+constexpr double kCortexModelMaxInPlaneMm = 1.0, kCortexModelMaxSliceMm = 3.0;
 
 struct EdgeSnapOptions {
   double search_mm = 0;         // edge search either side of a vertex (0: 1.5 voxels inwards, at least 1.5 mm; a quarter voxel outwards, at least 0.75 mm)
@@ -63,7 +63,8 @@ struct EdgeSnapOptions {
   /// outer surface of a blurred-cortex model fitted to the voxels about the
   /// normal (imaging/cortex_edge.hpp), which a thin cortex does not pull
   /// outwards; Automatic: the model on CTs whose voxels are at most
-  /// kCortexModelMaxVoxelMm on every side, the steepest fall beyond.
+  /// kCortexModelMaxInPlaneMm within the slices and kCortexModelMaxSliceMm
+  /// across them, the steepest fall beyond.
   EdgeModel edge_model = EdgeModel::Automatic;
   /// The scanner's Gaussian point-spread for the model, mm, within the
   /// slices and across them (0: both estimated from the CT's own edges;
@@ -85,6 +86,7 @@ struct EdgeSnapSummary {
   double point_spread_mm = 0, slice_point_spread_mm = 0;  // within the slices, across them
   bool point_spread_estimated = false;
   bool point_spread_on_voxel_grid = false;  // the blur was an image filter's on the voxels (imaging::PointSpread::Kind)
+  bool cortex_held_across_slices = false;   // the lines across the slices held the cortex of the lines within them
   long long on_cortex_model = 0;
   double mean_model_shift_mm = 0;
   std::string cortex_model_note;  // why the model was not used, when it was asked for
