@@ -25,6 +25,7 @@
 #include "articula/report/error_statistics.hpp"
 #include "articula/report/histogram_svg.hpp"
 #include "articula/mesh/mesh.hpp"
+#include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/report/ply_writers.hpp"
 
 namespace articula::apps {
@@ -81,18 +82,11 @@ class ErrorsCommand : public cli::Command {
     app.add_option("-i,--input", input_, "The points that were fitted (LPS mm)")->required();
     app.add_option("--fits", fits_, "fits.json written by articula-fit")->required();
     app.add_option("-o,--output", output_, "Output folder")->required();
-    app.add_option("--band", band_mm_, "Half-width of the green band of the coloured points (mm)")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
-    app.add_option("--resolution", resolution_, "Surface mesh steps around the local z axis")
-        ->check(CLI::Range(8, 2048))
-        ->capture_default_str();
-    app.add_option("--map-points", map_points_, "Points drawn per model in error_map.svg (every k-th when more)")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+    pipeline::addStageOptions(app, name(), settings_);
   }
 
   int run(const cli::CommonOptions& common) override {
+    const pipeline::ErrorsSettings& given = settings_.errors;
     const points::PointCloud cloud = points::readPoints(input_);
     points::checkFittable(cloud, 1, input_.string());
     const nlohmann::json doc = readJsonFile(fits_, "--fits");
@@ -139,15 +133,15 @@ class ErrorsCommand : public cli::Command {
       const std::string comment = "articula errors: " + name + " signed Euclidean distances (mm), points " +
                                   input_.filename().string();
       writeFileAtomically(output_ / ("points_" + name + ".ply"),
-                          report::colouredPointsPly(P, d, band_mm_, comment), overwrite);
+                          report::colouredPointsPly(P, d, given.band_mm, comment), overwrite);
       mesh::writePointValues(output_ / ("points_" + name + ".vtp"), P, "signed_distance_mm", d, overwrite);
       const auto surface = geometry::makeSurface(shapes[m]);
-      const geometry::SurfaceMesh patch = surfacePatch(*surface, P, resolution_);
+      const geometry::SurfaceMesh patch = surfacePatch(*surface, P, given.resolution);
       writeFileAtomically(output_ / ("surface_" + name + ".ply"),
                           report::meshPly(patch.vertices, patch.triangles, "articula fitted " + name), overwrite);
     }
 
-    nlohmann::json params = {{"fits", fits_.string()}, {"band_mm", band_mm_}, {"resolution", resolution_}};
+    nlohmann::json params = {{"fits", fits_.string()}, {"band_mm", given.band_mm}, {"resolution", given.resolution}};
     const nlohmann::json provenance = provenanceJson({params, {input_, fits_}, -1});
     writeFileAtomically(output_ / "summary.csv", report::summaryCsv(rows), overwrite);
     {
@@ -185,7 +179,7 @@ class ErrorsCommand : public cli::Command {
     std::vector<report::ErrorMapPanel> panels;
     for (size_t m = 0; m < shapes.size(); ++m) panels.push_back({rows[m].model, all.col(static_cast<Eigen::Index>(m))});
     report::ErrorMapOptions map_options;
-    map_options.max_points = map_points_;
+    map_options.max_points = given.map_points;
     map_options.highlight = rows[best].model;
     writeFileAtomically(output_ / "error_map.svg",
                         report::errorMapSvg(report::azimuthalEqualArea(P, shapes[best].center), panels, map_options,
@@ -207,9 +201,7 @@ class ErrorsCommand : public cli::Command {
 
  private:
   std::filesystem::path input_, fits_, output_;
-  double band_mm_ = 0.1;
-  int resolution_ = 96;
-  int map_points_ = 2000;
+  pipeline::StageSettings settings_;
 };
 
 ARTICULA_REGISTER_COMMAND(ErrorsCommand)

@@ -17,6 +17,7 @@
 #include "articula/core/provenance.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/fits_json.hpp"
+#include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/points/point_io.hpp"
 
 namespace articula::apps {
@@ -85,36 +86,25 @@ class FitCommand : public cli::Command {
     app.add_option("-i,--input", input_, "Points (.ply, .csv/.xyz/.txt, or the vertices of .stl/.obj/.vtp), LPS mm")
         ->required();
     app.add_option("-o,--output", output_, "fits.json (fits.csv is written beside it)")->required();
-    app.add_option("--models", models_, "Comma-separated models to report")->delimiter(',')->capture_default_str();
-    app.add_option("--objective", objective_, "geometric (orthogonal distances) or algebraic (thesis eq. 3.1)")
-        ->capture_default_str();
-    app.add_option("--strategy", strategy_, "local (from the hierarchical start) or global-local (GN_CRS2_LM first)")
-        ->capture_default_str();
-    app.add_option("--local-algorithm", local_algorithm_, "Local method: LM (Levenberg-Marquardt on the residuals) or NLopt's LD_SLSQP, LN_BOBYQA, LD_LBFGS, LD_MMA")
-        ->capture_default_str();
-    app.add_option("--max-evaluations", max_evaluations_, "Evaluation cap per local run")->capture_default_str();
-    app.add_option("--sample-points", sample_points_,
-                   "More points than this: fit on a seeded random sample of this many, then finish on all (0 = always all)")
-        ->check(CLI::Range(0, 100000000))
-        ->capture_default_str();
-    app.add_option("--bounds", bounds_file_, "JSON of parameter bounds overrides, e.g. {\"gamma1\": [2, 3]}");
+    pipeline::addStageOptions(app, name(), settings_);
   }
 
   int run(const cli::CommonOptions& common) override {
+    const pipeline::FitSettings& given = settings_.fit;
     fit::Options o;
     o.models.clear();
-    for (const auto& m : models_) o.models.push_back(geometry::modelFromName(m));
-    o.objective = fit::objectiveFromName(objective_);
-    o.strategy = fit::strategyFromName(strategy_);
-    o.local_algorithm = local_algorithm_;
-    o.max_evaluations = max_evaluations_;
-    o.sample_points = sample_points_;
+    for (const auto& m : given.models) o.models.push_back(geometry::modelFromName(m));
+    o.objective = fit::objectiveFromName(given.objective);
+    o.strategy = fit::strategyFromName(given.strategy);
+    o.local_algorithm = given.local_algorithm;
+    o.max_evaluations = given.max_evaluations;
+    o.sample_points = given.sample_points;
     o.seed = static_cast<unsigned>(common.seed);
-    if (!bounds_file_.empty()) o.bounds = readBounds(bounds_file_);
+    if (!given.bounds.empty()) o.bounds = readBounds(given.bounds);
     o.validate();
     if (output_.extension() != ".json") throw UsageError("--output: expected a .json file, found '" + output_.string() + "'");
     const std::filesystem::path csv = std::filesystem::path(output_).replace_extension(".csv");
-    refuseOutputsOverInputs({output_, csv}, {input_, bounds_file_});
+    refuseOutputsOverInputs({output_, csv}, {input_, given.bounds});
     checkOutputTarget(output_);
     cli::refuseExistingOutputs({output_, csv}, common.force);
 
@@ -128,19 +118,19 @@ class FitCommand : public cli::Command {
 
     nlohmann::json models = nlohmann::json::array();
     for (const auto& f : summary.fits) models.push_back(fit::modelFitJson(f));
-    nlohmann::json params = {{"models", models_},           {"objective", objective_},
-                             {"strategy", strategy_},       {"local_algorithm", local_algorithm_},
-                             {"max_evaluations", max_evaluations_}, {"sample_points", sample_points_}, {"bounds", nlohmann::json(o.bounds)}};
+    nlohmann::json params = {{"models", given.models},           {"objective", given.objective},
+                             {"strategy", given.strategy},       {"local_algorithm", given.local_algorithm},
+                             {"max_evaluations", given.max_evaluations}, {"sample_points", given.sample_points}, {"bounds", nlohmann::json(o.bounds)}};
     nlohmann::json doc = {{"coordinate_system", "LPS"},
                           {"units", "mm"},
                           {"input", input_.string()},
                           {"n_points", cloud.positions.rows()},
-                          {"objective", objective_},
+                          {"objective", given.objective},
                           {"least_rms_model", summary.best_model},
                           {"seconds", summary.seconds},
                           {"models", models},
                           {"provenance", provenanceJson({params, {input_}, common.seed})}};
-    if (!bounds_file_.empty()) doc["provenance"] = provenanceJson({params, {input_, bounds_file_}, common.seed});
+    if (!given.bounds.empty()) doc["provenance"] = provenanceJson({params, {input_, given.bounds}, common.seed});
     writeFileAtomically(output_, doc.dump(2) + "\n", common.force);
     writeFileAtomically(csv, fitsCsv(summary), common.force);
     if (common.json)
@@ -150,11 +140,8 @@ class FitCommand : public cli::Command {
   }
 
  private:
-  std::filesystem::path input_, output_, bounds_file_;
-  std::vector<std::string> models_ = {"sphere", "ellipsoid", "superellipsoid", "ovoid", "superovoid"};
-  std::string objective_ = "geometric", strategy_ = "local", local_algorithm_ = fit::Options{}.local_algorithm;
-  int max_evaluations_ = fit::Options{}.max_evaluations;
-  int sample_points_ = fit::Options{}.sample_points;
+  std::filesystem::path input_, output_;
+  pipeline::StageSettings settings_;
 };
 
 ARTICULA_REGISTER_COMMAND(FitCommand)

@@ -8,6 +8,7 @@
 #include "articula/core/provenance.hpp"
 #include "articula/imaging/io.hpp"
 #include "articula/mesh/mesh.hpp"
+#include "articula/pipeline/stage_options_cli.hpp"
 
 namespace articula::apps {
 namespace {
@@ -22,66 +23,41 @@ class MeshCommand : public cli::Command {
   void declare(CLI::App& app) override {
     app.add_option("-i,--input", input_, "Label image (.nii.gz, .nrrd, .mha); non-zero = bone")->required();
     app.add_option("-o,--output", output_, "Mesh (.vtp, .stl or .ply)")->required();
-    app.add_option("--smoothing", smoothing_, "laplacian, sinc (windowed sinc) or none")
-        ->check(CLI::IsMember({"laplacian", "sinc", "none"}))->capture_default_str();
-    app.add_option("--smooth-iterations", options_.smooth_iterations, "Smoothing iterations")->capture_default_str();
-    app.add_option("--relaxation", options_.relaxation, "Laplacian relaxation factor")->capture_default_str();
-    app.add_option("--passband", options_.passband, "Windowed sinc pass band")->capture_default_str();
-    app.add_option("--decimate", options_.decimate, "Fraction of triangles to remove (0 = none)")->capture_default_str();
-    app.add_flag("--all-components", all_components_, "Keep every connected surface, not only the largest");
     app.add_option("--ct", ct_,
                    "The CT the label came from (DICOM folder or image file): vertices move along their normals onto "
                    "its bone edge (sub-voxel; without it the surface is the label's smoothed voxel boundary)");
-    app.add_option("--series-uid", series_uid_, "With --ct: the DICOM series to read when the folder holds several (empty: the series whose UID is empty)");
-    app.add_option("--edge-search", snap_.search_mm,
-                   "With --ct: edge search either side of a vertex, mm (0: 1.5 voxels, at least 1.5 mm)")
-        ->check(CLI::Range(0.0, 10.0))
-        ->capture_default_str();
-    app.add_option("--edge-model", edge_model_,
-                   "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
-                   "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
-                   "the voxels about the normal, with one point-spread for the CT; 'auto' the cortex model on CTs "
-                   "whose voxels are at most 1 mm within the slices and 3 mm across them, the steepest fall beyond")
-        ->check(CLI::IsMember({"auto", "cortex", "steepest"}))
-        ->capture_default_str();
-    app.add_option("--point-spread", snap_.point_spread_mm,
-                   "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation) within "
-                   "the slices, mm (0: this and the slices' estimated from the CT's edges)")
-        ->check(CLI::Range(0.0, 3.0))
-        ->capture_default_str();
-    app.add_option("--slice-point-spread", snap_.slice_point_spread_mm,
-                   "With --point-spread: the point-spread across the slices (the slice profile's standard deviation), "
-                   "mm (0: as within the slices)")
-        ->check(CLI::Range(0.0, 3.0))
-        ->capture_default_str();
+    pipeline::addStageOptions(app, name(), settings_);
   }
   int run(const cli::CommonOptions& common) override {
+    const pipeline::MeshSettings& given = settings_.mesh;
+    mesh::MeshOptions options = given.surface;
+    mesh::EdgeSnapOptions snap = given.edges;
     imaging::limitImagingThreads(common.threadCount());
-    options_.smoothing = smoothing_ == "laplacian" ? mesh::Smoothing::Laplacian
-                         : smoothing_ == "sinc"    ? mesh::Smoothing::WindowedSinc
+    options.smoothing = given.smoothing == "laplacian" ? mesh::Smoothing::Laplacian
+                         : given.smoothing == "sinc"    ? mesh::Smoothing::WindowedSinc
                                                    : mesh::Smoothing::None;
-    options_.largest_component = !all_components_;
-    options_.validate();
+    options.largest_component = !given.all_components;
+    options.validate();
     const std::string ext = output_.extension().string();
     if (ext != ".vtp" && ext != ".stl" && ext != ".ply")
       throw UsageError("--output: expected a .vtp, .stl or .ply file, found '" + output_.string() + "'");
     cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
-    snap_.edge_model = edge_model_ == "cortex"     ? mesh::EdgeModel::Cortex
-                       : edge_model_ == "steepest" ? mesh::EdgeModel::SteepestFall
+    snap.edge_model = given.edge_model == "cortex"     ? mesh::EdgeModel::Cortex
+                       : given.edge_model == "steepest" ? mesh::EdgeModel::SteepestFall
                                                    : mesh::EdgeModel::Automatic;
-    snap_.validate();
+    snap.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
     checkOutputTarget(output_);
     const imaging::Label label = imaging::readLabel(input_);
     mesh::MeshSummary s;
-    mesh::TriangleMesh m = mesh::extractSurface(label, options_, &s);
+    mesh::TriangleMesh m = mesh::extractSurface(label, options, &s);
     nlohmann::json edges = nullptr;
     if (!ct_.empty()) {
       imaging::ReadOptions read;
-      read.series_uid = series_uid_;
+      read.series_uid = given.series_uid;
       const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(ct_, read);
       mesh::EdgeSnapSummary snapped;
-      mesh::snapToEdges(m, *ct, snap_, &snapped);
+      mesh::snapToEdges(m, *ct, snap, &snapped);
       const double share = snapped.vertices ? static_cast<double>(snapped.on_edge) / snapped.vertices : 0.0;
       edges = {{"ct", ct_.string()},
                {"moved", snapped.moved},
@@ -111,12 +87,12 @@ class MeshCommand : public cli::Command {
     }
     mesh::writeMesh(output_, m, true);
     log::info("mesh: " + std::to_string(s.vertices) + " vertices, " + std::to_string(s.triangles) + " triangles");
-    nlohmann::json params = {{"smoothing", smoothing_}, {"smooth_iterations", options_.smooth_iterations},
-                             {"relaxation", options_.relaxation}, {"passband", options_.passband},
-                             {"decimate", options_.decimate}, {"largest_component", options_.largest_component},
-                             {"edge_search_mm", snap_.search_mm}, {"edge_model", edge_model_},
-                             {"point_spread_mm", snap_.point_spread_mm},
-                             {"slice_point_spread_mm", snap_.slice_point_spread_mm}};
+    nlohmann::json params = {{"smoothing", given.smoothing}, {"smooth_iterations", options.smooth_iterations},
+                             {"relaxation", options.relaxation}, {"passband", options.passband},
+                             {"decimate", options.decimate}, {"largest_component", options.largest_component},
+                             {"edge_search_mm", snap.search_mm}, {"edge_model", given.edge_model},
+                             {"point_spread_mm", snap.point_spread_mm},
+                             {"slice_point_spread_mm", snap.slice_point_spread_mm}};
     nlohmann::json summary = {{"input", input_.string()},       {"output", output_.string()},
                               {"label_voxels", s.label_voxels}, {"raw_triangles", s.raw_triangles},
                               {"triangles", s.triangles},       {"vertices", s.vertices},
@@ -132,10 +108,7 @@ class MeshCommand : public cli::Command {
 
  private:
   std::filesystem::path input_, output_, ct_;
-  std::string smoothing_ = "laplacian", series_uid_, edge_model_ = "auto";
-  mesh::EdgeSnapOptions snap_;
-  bool all_components_ = false;
-  mesh::MeshOptions options_;
+  pipeline::StageSettings settings_;
 };
 
 ARTICULA_REGISTER_COMMAND(MeshCommand)

@@ -5,6 +5,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/pipeline/stages.hpp"
 #include "articula/pipeline/subject_report.hpp"
 
@@ -22,18 +23,13 @@ class ReportCommand : public cli::Command {
     app.add_option("-i,--input", options_.folder, "Subject folder holding fits.json, errors/summary.json and points.ply")
         ->required();
     app.add_option("--ct", options_.ct, "The subject's CT (recorded in results.json; hashed when it is a file)");
-    app.add_option("--series-uid", options_.series_uid,
-                   "Series Instance UID of the CT in a DICOM folder holding several (for the slices of report.html)");
     app.add_option("--joint", options_.joint, "hip or shoulder (recorded)")
         ->check(CLI::IsMember({"hip", "shoulder"}))
         ->capture_default_str();
     app.add_option("--side", options_.side, "right or left (recorded)")
         ->check(CLI::IsMember({"right", "left"}))
         ->capture_default_str();
-    app.add_option("--selection-alpha", options_.selection_alpha,
-                   "Level of the nested tests that take a richer model (with the residuals' correlation; 0: always the sphere)")
-        ->check(CLI::Range(0.0, 0.5))
-        ->capture_default_str();
+    pipeline::addStageOptions(app, name(), settings_);
   }
   int run(const cli::CommonOptions& common) override {
     if (!std::filesystem::is_directory(options_.folder))
@@ -56,7 +52,8 @@ class ReportCommand : public cli::Command {
   }
 
  private:
-  pipeline::SubjectReportOptions options_;
+  pipeline::StageSettings settings_;
+  pipeline::SubjectReportOptions& options_ = settings_.report;
 };
 
 ARTICULA_REGISTER_COMMAND(ReportCommand)

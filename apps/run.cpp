@@ -10,6 +10,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <optional>
 
@@ -25,6 +26,7 @@
 #include "articula/core/provenance.hpp"
 #include "articula/core/version.hpp"
 #include "articula/imaging/io.hpp"
+#include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/pipeline/stages.hpp"
 
 namespace articula::apps {
@@ -43,6 +45,17 @@ std::string hashInput(const fs::path& path) {
   std::string all;
   for (const auto& f : files) all += fs::relative(f, path).string() + ":" + sha256File(f) + "\n";
   return sha256String(all);
+}
+
+// An argument as a POSIX shell reads it back: bare when it holds only
+// characters no shell treats specially, else in single quotes.
+std::string shellWord(const std::string& arg) {
+  if (!arg.empty() && arg.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_./,:=+-@%") ==
+                          std::string::npos)
+    return arg;
+  std::string quoted = "'";
+  for (const char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
 }
 
 std::string number(double v) {
@@ -70,14 +83,11 @@ class RunCommand : public cli::Command {
     app.add_option("--from", from_, "First stage to run (earlier outputs must exist): " + pipeline::stageNames())
         ->check(CLI::IsMember(names));
     app.add_option("--until", until_, "Last stage to run")->check(CLI::IsMember(names));
-    // Every stage's options, from the stage table; a stage that two stages
-    // take (series-uid) goes to both. Checked by the stage's own parser
-    // before any stage runs (argumentsProblem).
-    for (const auto& stage : pipeline::stages())
-      for (const auto& option : stage.options)
-        if (!app.get_option_no_throw("--" + option))
-          app.add_option("--" + option, forwarded_[option], "Passed to the " + takers(option) + " (see articula " +
-                                                                 stage.name + " --help)");
+    app.add_flag("--dry-run", dry_run_,
+                 "Print each stage's command line (from --from to --until) and run nothing; with --json as JSON");
+    // Every stage's options (pipeline/stage_options.hpp), typed and checked
+    // here, then passed to the stages that take them.
+    stage_options_ = pipeline::addRunOptions(app, settings_);
   }
 
   std::string argumentsProblem(const cli::CommonOptions& common) const override {
@@ -102,6 +112,10 @@ class RunCommand : public cli::Command {
                        "expected a DICOM folder or a CT image file");
     if (fs::exists(output_) && !fs::is_directory(output_))
       throw UsageError("output '" + output_.string() + "' is a file: expected a folder for the stages' outputs");
+    if (dry_run_) {
+      printPlan(first, last, common);
+      return 0;
+    }
     // One run per output folder at a time; a run that fails before any
     // stage has written leaves no trace of itself there.
     OutputLock lock(output_, "articula run");
@@ -134,16 +148,6 @@ class RunCommand : public cli::Command {
                             table.begin());
   }
 
-  // "segment and mesh stages": every stage that takes the option.
-  static std::string takers(const std::string& option) {
-    std::vector<std::string> names;
-    for (const auto& stage : pipeline::stages())
-      if (std::find(stage.options.begin(), stage.options.end(), option) != stage.options.end()) names.push_back(stage.name);
-    std::string s;
-    for (size_t i = 0; i < names.size(); ++i) s += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
-    return s + (names.size() > 1 ? " stages" : " stage");
-  }
-
   // Where a stage reads and writes in OUTDIR (the table's file names), and the
   // arguments its command gets: its files, the options given for it, the
   // standard options.
@@ -152,14 +156,30 @@ class RunCommand : public cli::Command {
     for (const auto& in : stage.inputs) p.inputs.push_back(in == "CT" ? input_ : output_ / in);
     for (const auto& out : stage.outputs) p.outputs.push_back(output_ / out);
     p.args = pipeline::expandArguments(stage, input_.string(), output_.string(), joint_, side_);
-    for (const auto& option : stage.options)
-      if (auto it = forwarded_.find(option); it != forwarded_.end() && !it->second.empty())
-        p.args.insert(p.args.end(), {"--" + option, it->second});
+    const std::vector<std::string> given = pipeline::forwardedArguments(stage.name, stage_options_);
+    p.args.insert(p.args.end(), given.begin(), given.end());
     p.args.insert(p.args.end(), {"--seed", std::to_string(common.seed), "--threads", std::to_string(common.threadCount()),
                                  "--force"});
     if (common.verbosity == 0) p.args.push_back("--quiet");
     if (common.verbosity == 2) p.args.push_back("--verbose");
     return p;
+  }
+
+  // --dry-run: each stage's command line, as a shell would take it, or as JSON.
+  void printPlan(int first, int last, const cli::CommonOptions& common) const {
+    json plan = json::array();
+    for (int i = first; i <= last; ++i) {
+      const pipeline::StageDescription& stage = pipeline::stages()[static_cast<size_t>(i)];
+      const std::vector<std::string> args = stagePlan(stage, common).args;
+      if (common.json) {
+        plan.push_back({{"stage", stage.name}, {"arguments", args}});
+        continue;
+      }
+      std::string line = "articula " + stage.name;
+      for (const std::string& arg : args) line += " " + shellWord(arg);
+      std::cout << line << "\n";
+    }
+    if (common.json) cli::printJson({{"stages", plan}});
   }
 
   // Runs stages first..last under the output folder's lock; a stage's exit
@@ -270,7 +290,9 @@ class RunCommand : public cli::Command {
 
   fs::path input_, output_;
   std::string joint_ = "hip", side_ = "right", from_, until_;
-  std::map<std::string, std::string> forwarded_;
+  bool dry_run_ = false;
+  pipeline::StageSettings settings_;  // run's values of the stage options (only those given are passed on)
+  std::map<std::string, CLI::Option*> stage_options_;
 };
 
 ARTICULA_REGISTER_COMMAND(RunCommand)

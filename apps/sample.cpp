@@ -10,6 +10,7 @@
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/mesh/mesh.hpp"
+#include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/points/point_io.hpp"
 #include "articula/sampling/downsample.hpp"
 #include "articula/sampling/select.hpp"
@@ -29,22 +30,17 @@ class SampleCommand : public cli::Command {
   void declare(CLI::App& app) override {
     app.add_option("-i,--input", input_, "Mesh (.vtp, .stl, .ply, .vtk, .obj) in LPS mm")->required();
     app.add_option("-o,--output", output_, "Points (.ply, or .csv)")->required();
-    app.add_option("--select", select_, "auto | sphere:X,Y,Z,R | box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (LPS mm)")
-        ->capture_default_str();
-    app.add_option("--ball-radius", down_.ball_radius_mm, "Open-ball radius of the down-sampling (mm)")->capture_default_str();
-    app.add_option("--ratio", down_.ratio, "Stop when kept/original reaches this fraction (1: until no point is left)")
-        ->capture_default_str();
-    app.add_option("--min-radius", select_options_.min_radius_mm, "auto: smallest head radius (mm)")->capture_default_str();
-    app.add_option("--max-radius", select_options_.max_radius_mm, "auto: largest head radius (mm)")->capture_default_str();
-    app.add_option("--band", select_options_.band_mm, "auto: distance band around the sphere (mm)")->capture_default_str();
-    app.add_option("--min-points", select_options_.min_points, "Fewest selected points accepted")->capture_default_str();
+    pipeline::addStageOptions(app, name(), settings_);
     app.add_option("--format", format_, "ply or csv (default: from the extension)")->check(CLI::IsMember({"ply", "csv"}));
   }
   int run(const cli::CommonOptions& common) override {
-    sampling::parseSelection(select_, select_options_);
+    const pipeline::SampleSettings& given = settings_.sample;
+    sampling::SelectOptions select_options = given.selection;
+    sampling::DownsampleOptions down = given.downsampling;
+    sampling::parseSelection(given.select, select_options);
     if (common.seed < 0) throw UsageError("--seed: expected a non-negative integer");
-    select_options_.seed = down_.seed = static_cast<unsigned long long>(common.seed);
-    down_.validate();
+    select_options.seed = down.seed = static_cast<unsigned long long>(common.seed);
+    down.validate();
     if (!format_.empty()) output_.replace_extension(format_);
     const std::string ext = output_.extension().string();
     if (ext != ".ply" && ext != ".csv") throw UsageError("--output: expected a .ply or .csv file, found '" + output_.string() + "'");
@@ -53,17 +49,17 @@ class SampleCommand : public cli::Command {
     cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
     const mesh::TriangleMesh m = mesh::readMesh(input_);
-    const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options_);
+    const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options);
     Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3), Nsel(P.rows(), 3);
     for (size_t i = 0; i < sel.indices.size(); ++i) {
       P.row(static_cast<Eigen::Index>(i)) = m.vertices.row(sel.indices[i]);
       if (m.normals.rows() == m.vertices.rows()) Nsel.row(static_cast<Eigen::Index>(i)) = m.normals.row(sel.indices[i]);
     }
     sampling::DownsampleSummary ds;
-    const std::vector<int> kept = sampling::gaussianDownsample(P, down_, &ds);
-    if (static_cast<int>(kept.size()) < select_options_.min_points)
+    const std::vector<int> kept = sampling::gaussianDownsample(P, down, &ds);
+    if (static_cast<int>(kept.size()) < select_options.min_points)
       throw ProcessingError("down-sampling left " + std::to_string(kept.size()) + " articular points; expected at least " +
-                       std::to_string(select_options_.min_points) + " (reduce --ball-radius)");
+                       std::to_string(select_options.min_points) + " (reduce --ball-radius)");
     points::PointCloud cloud;
     cloud.positions.resize(static_cast<Eigen::Index>(kept.size()), 3);
     if (m.normals.rows() == m.vertices.rows()) cloud.normals.resize(cloud.positions.rows(), 3);
@@ -72,17 +68,17 @@ class SampleCommand : public cli::Command {
       if (cloud.normals.rows()) cloud.normals.row(static_cast<Eigen::Index>(i)) = Nsel.row(kept[i]);
     }
     std::ostringstream note;
-    note << "articula sample: " << ds.original << " selected, " << ds.reduced << " kept, open ball " << down_.ball_radius_mm
+    note << "articula sample: " << ds.original << " selected, " << ds.reduced << " kept, open ball " << down.ball_radius_mm
          << " mm, seed " << common.seed;
     points::writePoints(output_, cloud, {note.str()}, true);
     log::info("sample: " + note.str().substr(std::string("articula sample: ").size()) + " (" + ds.termination + ")");
 
-    nlohmann::json params = {{"select", select_},
-                             {"ball_radius_mm", down_.ball_radius_mm},
-                             {"ratio", down_.ratio},
-                             {"min_radius_mm", select_options_.min_radius_mm},
-                             {"max_radius_mm", select_options_.max_radius_mm},
-                             {"band_mm", select_options_.band_mm}};
+    nlohmann::json params = {{"select", given.select},
+                             {"ball_radius_mm", down.ball_radius_mm},
+                             {"ratio", down.ratio},
+                             {"min_radius_mm", select_options.min_radius_mm},
+                             {"max_radius_mm", select_options.max_radius_mm},
+                             {"band_mm", select_options.band_mm}};
     nlohmann::json summary = {
         {"input", input_.string()},
         {"output", output_.string()},
@@ -94,7 +90,7 @@ class SampleCommand : public cli::Command {
         {"percentage", ds.original ? 100.0 * static_cast<double>(ds.reduced) / static_cast<double>(ds.original) : 0.0},
         {"termination", ds.termination},
         {"provenance", provenanceJson({params, {input_}, common.seed})}};
-    if (select_options_.mode == sampling::SelectOptions::Mode::Auto)
+    if (select_options.mode == sampling::SelectOptions::Mode::Auto)
       summary["sphere"] = {{"center_mm", {sel.sphere_center[0], sel.sphere_center[1], sel.sphere_center[2]}},
                            {"radius_mm", sel.sphere_radius},
                            {"rms_mm", sel.sphere_rms_mm},
@@ -106,9 +102,8 @@ class SampleCommand : public cli::Command {
 
  private:
   std::filesystem::path input_, output_;
-  std::string select_ = "auto", format_;
-  sampling::SelectOptions select_options_;
-  sampling::DownsampleOptions down_;
+  std::string format_;
+  pipeline::StageSettings settings_;
 };
 
 ARTICULA_REGISTER_COMMAND(SampleCommand)

@@ -28,9 +28,16 @@ class StagesCommand : public cli::Command {
       cli::printJson(pipeline::stagesJson());
       return 0;
     }
-    for (const auto& s : pipeline::stages())
+    for (const auto& s : pipeline::stages()) {
       std::cout << s.name << ": " << s.description << "\n  reads: " << joined(s.inputs)
-                << "\n  writes: " << joined(s.outputs) << "\n  options: " << joined(s.options) << "\n";
+                << "\n  writes: " << joined(s.outputs) << "\n  options:" << (s.options.empty() ? " -" : "") << "\n";
+      for (const auto& o : s.options) {
+        const std::string range = o.rangeText(), fallback = o.defaultText();
+        std::cout << "    --" << o.name << (o.runName() != o.name ? " (run: --" + o.runName() + ")" : "") << " "
+                  << pipeline::typeName(o.type()) << (o.unit.empty() ? "" : ", " + o.unit)
+                  << (range.empty() ? "" : ", " + range) << (fallback.empty() ? "" : ", default " + fallback) << "\n";
+      }
+    }
     return 0;
   }
 };

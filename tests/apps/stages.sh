@@ -16,9 +16,10 @@ stages = json.load(open(sys.argv[1]))["stages"]
 names = [s["name"] for s in stages]
 assert names == ["segment", "mesh", "sample", "fit", "errors", "report"], names
 by = {s["name"]: s for s in stages}
-assert "series-uid" in by["segment"]["options"] and "series-uid" in by["mesh"]["options"]
-assert "smoothing" in by["mesh"]["options"], by["mesh"]
-assert by["report"]["options"] == ["series-uid", "selection-alpha"], by["report"]
+options = {s["name"]: [o["name"] for o in s["options"]] for s in stages}
+assert "series-uid" in options["segment"] and "series-uid" in options["mesh"]
+assert "smoothing" in options["mesh"], by["mesh"]
+assert options["report"] == ["series-uid", "selection-alpha"], by["report"]
 assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"]
 assert "CT" in by["mesh"]["inputs"]
 # Every stage's command line names the files it reads and the first it writes
@@ -32,7 +33,7 @@ assert by["segment"]["arguments"][:4] == ["-i", "{CT}", "-o", "{folder}/label.ni
 help_text = open(sys.argv[2]).read()
 for s in stages:
     for o in s["options"]:
-        assert f"--{o}" in help_text, f"run does not take --{o}"
+        assert f"--{o['run_name']}" in help_text, f"run does not take --{o['run_name']}"
 PY
 
 # The seed-5 sphere phantom and its run, made once for several tests; the

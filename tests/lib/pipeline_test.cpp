@@ -169,6 +169,16 @@ TEST(Manifest, ResolvesPathsAndOptions) {
   rejects("subject,input,joint,side,ratio,ratio\na,x,hip,left,1,2\n", "column 'ratio' appears twice");
   rejects("subject,input,joint,side,x\n\x1b[31m,x,hip,left,1\n", "\\x1b[31m");
   rejects("subject,input,joint,side\n", "at least one subject");
+  // Stage options' values, checked by their declarations, line and stage named.
+  rejects("subject,input,joint,side,selection_alpha\na,x,hip,left,0.01\nb,x,hip,left,5\n",
+          "bad.csv:3: column 'selection_alpha': the report stage: --selection-alpha: expected 0 to 0.5, found 5");
+  rejects("subject,input,joint,side,min_radius\na,x,hip,left,70\n", "the segment stage: --min-radius (mm)");
+  rejects("subject,input,joint,side,seed_point\na,x,hip,left,\"1,2\"\n", "expected 3 numbers");
+  rejects("subject,input,joint,side,all_components\na,x,hip,left,yes\n", "expected true or false, found 'yes'");
+  write(dir / "flags.csv", "subject,input,joint,side,all_components,errors_band\na,x,hip,left,true,0.3\nb,x,hip,left,false,\n");
+  const auto flagged = p::readManifest(dir / "flags.csv");
+  EXPECT_EQ(flagged[0].options, (std::vector<std::string>{"--all-components", "--errors-band", "0.3"}));
+  EXPECT_TRUE(flagged[1].options.empty());
 }
 
 TEST(Manifest, SpreadsheetByteOrderMarkIsNoPartOfTheHeader) {

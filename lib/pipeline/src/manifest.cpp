@@ -6,6 +6,7 @@
 #include "articula/core/excerpt.hpp"
 #include "articula/core/csv.hpp"
 #include "articula/imaging/io.hpp"
+#include "articula/pipeline/stage_options.hpp"
 
 namespace articula::pipeline {
 
@@ -31,6 +32,30 @@ void checkOptionColumn(const std::string& column, const fs::path& manifest) {
     throw InputError(where + "--" + option +
                      " is set by the batch for every subject (outputs go to STUDYDIR/<subject>, every stage runs); "
                      "a manifest column may set a stage option only");
+}
+// A cell of a column: `--name value`, a flag's `--name` when it is true.
+// A stage option's value is checked by its declaration (stage_options.hpp)
+// here, where its line is known; a column that names no stage option is
+// left to run's parser, which the batch asks before any subject runs.
+void addOption(std::vector<std::string>& options, const std::string& column, const std::string& value,
+               const std::string& where) {
+  std::string name = column;
+  for (char& ch : name)
+    if (ch == '_') ch = '-';
+  const std::vector<StageOptionOf> declared = optionsRunAs(name);
+  if (!declared.empty() && declared.front().option->type() == OptionType::Flag) {
+    if (value != "true" && value != "false")
+      throw InputError(where + "column '" + column + "': expected true or false, found '" + excerpt(value) + "'");
+    if (value == "true") options.push_back("--" + name);
+    return;
+  }
+  for (const StageOptionOf& taker : declared) {
+    const OptionType type = taker.option->type();
+    const bool list = type == OptionType::Numbers || type == OptionType::Choices;
+    const std::string problem = taker.option->problem(list ? splitList(value) : std::vector<std::string>{value});
+    if (!problem.empty()) throw InputError(where + "column '" + column + "': the " + taker.stage + " stage: " + problem);
+  }
+  options.insert(options.end(), {"--" + name, value});
 }
 }  // namespace
 
@@ -71,14 +96,8 @@ std::vector<Subject> readManifest(const fs::path& manifest) {
       throw InputError(where + "joint: expected hip or shoulder, found '" + excerpt(s.joint) + "'");
     if (s.side != "left" && s.side != "right")
       throw InputError(where + "side: expected left or right, found '" + excerpt(s.side) + "'");
-    for (size_t c = 4; c < table.header.size(); ++c) {
-      if (row[c].empty()) continue;
-      std::string option = "--" + table.header[c];
-      for (char& ch : option)
-        if (ch == '_') ch = '-';
-      s.options.push_back(option);
-      s.options.push_back(row[c]);
-    }
+    for (size_t c = 4; c < table.header.size(); ++c)
+      if (!row[c].empty()) addOption(s.options, table.header[c], row[c], where);
     subjects.push_back(std::move(s));
   }
   if (subjects.empty()) throw InputError(manifest.string() + ": expected at least one subject row, found none");

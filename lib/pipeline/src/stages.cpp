@@ -19,7 +19,7 @@ const std::vector<StageDescription>& stages() {
   static const std::vector<StageDescription> table = {
       {"segment",
        "Segment the joint head from a CT (label image)",
-       {"seed-point", "series-uid", "hu-min", "hu-max", "roi", "level-set", "label", "label-value"},
+       stageOptions("segment"),
        {"CT"},
        {"label.nii.gz"},
        {"-i", "{CT}", "-o", "{folder}/label.nii.gz", "--joint", "{joint}", "--side", "{side}"},
@@ -28,7 +28,7 @@ const std::vector<StageDescription>& stages() {
       // The CT too: the surface moves onto its bone edge (sub-voxel).
       {"mesh",
        "Marching cubes and smoothing of the label, moved onto the CT's bone edge",
-       {"series-uid", "smoothing", "smooth-iterations", "relaxation", "decimate", "edge-model", "point-spread", "slice-point-spread"},
+       stageOptions("mesh"),
        {"label.nii.gz", "CT"},
        {"bone.vtp"},
        {"-i", "{folder}/label.nii.gz", "-o", "{folder}/bone.vtp", "--ct", "{CT}"},
@@ -36,7 +36,7 @@ const std::vector<StageDescription>& stages() {
        2, 2000},
       {"sample",
        "Articular surface of the mesh, Gaussian-downsampled to points with normals",
-       {"select", "ball-radius", "ratio"},
+       stageOptions("sample"),
        {"bone.vtp"},
        {"points.ply"},
        {"-i", "{folder}/bone.vtp", "-o", "{folder}/points.ply"},
@@ -44,7 +44,7 @@ const std::vector<StageDescription>& stages() {
        1, 500},
       {"fit",
        "The shape-model hierarchy fitted to the points",
-       {"models", "objective"},
+       stageOptions("fit"),
        {"points.ply"},
        {"fits.json", "fits.csv"},
        {"-i", "{folder}/points.ply", "-o", "{folder}/fits.json"},
@@ -52,7 +52,7 @@ const std::vector<StageDescription>& stages() {
        2, 1000},
       {"errors",
        "Signed Euclidean errors of every fitted model",
-       {},
+       stageOptions("errors"),
        {"points.ply", "fits.json"},
        {"errors/summary.json", "errors/histogram.svg", "errors/error_map.svg"},
        {"-i", "{folder}/points.ply", "--fits", "{folder}/fits.json", "-o", "{folder}/errors"},
@@ -61,7 +61,7 @@ const std::vector<StageDescription>& stages() {
        2, 1000},
       {"report",
        "Results, the selected model and the head's checks from the stage outputs",
-       {"series-uid", "selection-alpha"},
+       stageOptions("report"),
        {"fits.json", "errors/summary.json", "points.ply", "bone.vtp"},
        {"results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"},
        {"-i", "{folder}", "--ct", "{CT}", "--joint", "{joint}", "--side", "{side}"},
@@ -138,16 +138,19 @@ std::vector<std::string> stageFilesIn(const StageDescription& stage, const std::
 
 nlohmann::json stagesJson() {
   nlohmann::json list = nlohmann::json::array();
-  for (const auto& s : stages())
+  for (const auto& s : stages()) {
+    nlohmann::json options = nlohmann::json::array();
+    for (const auto& option : s.options) options.push_back(option.json());
     list.push_back({{"name", s.name},
                     {"description", s.description},
-                    {"options", s.options},
+                    {"options", options},
                     {"inputs", s.inputs},
                     {"outputs", s.outputs},
                     {"arguments", s.arguments},
                     {"sidecars", s.sidecars},
                     {"threads", s.threads},
                     {"memory_mb", s.memory_mb}});
+  }
   return {{"stages", list}};
 }
 

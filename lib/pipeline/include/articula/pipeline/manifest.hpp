@@ -1,8 +1,10 @@
 #pragma once
 // Batch manifests: one subject per row, columns `subject,input,joint,side`,
-// then optional per-subject options: a column `seed_point` with value
-// `1,2,3` becomes `--seed-point 1,2,3` for that subject (empty cells add
-// nothing). Relative inputs are resolved from the manifest's folder.
+// then optional per-subject options, any stage option under its name in
+// `articula run` (stage_options.hpp): a column `seed_point` with value
+// `1,2,3` becomes `--seed-point 1,2,3` for that subject, a flag's column
+// takes true or false (empty cells add nothing). Relative inputs are
+// resolved from the manifest's folder.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -20,7 +22,9 @@ struct Subject {
 
 /// Reads and checks a manifest; throws InputError naming the file and line for
 /// a missing column, an empty or duplicated subject id, an id that is not a
-/// safe folder name, or a joint/side outside hip|shoulder / left|right.
+/// safe folder name, a joint/side outside hip|shoulder / left|right, or a
+/// stage option's value its declaration refuses (out of range, not a number,
+/// no choice of its own).
 std::vector<Subject> readManifest(const std::filesystem::path& manifest);
 
 /// Problems with a subject's input that would make it fail (missing path,

@@ -1,23 +1,25 @@
 #pragma once
 // The pipeline's stages in run order, in one table: what each stage reads
-// and writes in a subject's folder, its command line there, and which
-// options a user may give for it through `articula run`, a batch manifest
-// column or the Snakemake workflow. `articula run` chains the stages from
-// it, `articula stages --json` prints it, and pipelines/Snakefile makes one
-// rule per stage from that print. Adding a stage: its command in apps/, one
-// row here.
+// and writes in a subject's folder, its command line there, and the options
+// a user may give for it through `articula run`, a batch manifest column or
+// the Snakemake workflow (declared in stage_options.hpp). `articula run`
+// chains the stages from it, `articula stages --json` prints it, and
+// pipelines/Snakefile makes one rule per stage from that print. Adding a
+// stage: its command in apps/, one row here, its options there.
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "articula/pipeline/stage_options.hpp"
+
 namespace articula::pipeline {
 
 struct StageDescription {
   std::string name;                  // also the command: articula <name>, articula-<name>
   std::string description;
-  std::vector<std::string> options;  // forwarded options, without "--" (manifest columns use '_' for '-')
+  std::vector<StageOption> options;  // what a user may set (stage_options.hpp)
   std::vector<std::string> inputs;   // in the subject folder; "CT" is the subject's input
   std::vector<std::string> outputs;  // in the subject folder
   /// Its command line in a subject's folder, without the standard options:
@@ -56,7 +58,8 @@ bool isStageFile(const StageDescription& stage, const std::string& file);
 /// The stage's outputs and sidecars that exist in `folder`, relative to it, sorted.
 std::vector<std::string> stageFilesIn(const StageDescription& stage, const std::filesystem::path& folder);
 
-/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments", "sidecars", "threads", "memory_mb"}, ...]}
+/// {"stages": [{"name", "description", "options", "inputs", "outputs", "arguments", "sidecars", "threads",
+/// "memory_mb"}, ...]}, each option as StageOption::json().
 nlohmann::json stagesJson();
 
 }  // namespace articula::pipeline
