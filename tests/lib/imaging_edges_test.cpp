@@ -127,5 +127,39 @@ TEST(Edges, FirstEdgeAlongARayIsTheHeadNotTheSocketBehindANarrowGap) {
   }
 }
 
+// A screw in the head (a 3.25 mm rod at 3,071 HU, a CT's ceiling, its tip
+// beyond the centre) lies on the rays cast from the centre: its fall is the
+// steepest on them, and the first. The ray's edge is the head's cortex all
+// the same.
+TEST(Edges, FirstEdgeAlongARayIsTheBoneNotAScrewInIt) {
+  imaging::Volume v;
+  const double h = 0.7;
+  v.geometry.size = Eigen::Vector3i(70, 70, 70);
+  v.geometry.spacing = Eigen::Vector3d::Constant(h);
+  v.geometry.origin = Eigen::Vector3d::Constant(-34.5 * h);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  const double sigma = 0.6;
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, 0.3, -0.2).normalized();
+  for (int k = 0; k < 70; ++k)
+    for (int j = 0; j < 70; ++j)
+      for (int i = 0; i < 70; ++i) {
+        const Eigen::Vector3d x = v.geometry.toPhysical(Eigen::Vector3d(i, j, k));
+        const double r = x.norm(), from_axis = (x - x.dot(axis) * axis).norm();
+        const double head = 350 + 950 * Phi((r - 18.5) / sigma);
+        const double bone = 40 + (head - 40) * Phi((20 - r) / sigma);
+        // From outside the bone at -25 mm to its tip 10 mm beyond the centre.
+        const double screw =
+            Phi((3.25 - from_axis) / sigma) * Phi((x.dot(axis) + 25) / sigma) * Phi((10 - x.dot(axis)) / sigma);
+        v.at(i, j, k) = static_cast<float>(bone + (3071 - bone) * screw);
+      }
+  // Past its tip (its fall at 10 mm), across it (at 3.25 mm) and aslant.
+  for (const Eigen::Vector3d& u : {axis, Eigen::Vector3d(axis.cross(Eigen::Vector3d::UnitZ()).normalized()),
+                                   Eigen::Vector3d(0, 1, 1).normalized()}) {
+    const imaging::Edge e = imaging::firstEdgeAlongRay(v, Eigen::Vector3d::Zero(), u, 0.0, 30.0, {});
+    ASSERT_TRUE(e.found);
+    EXPECT_NEAR(e.offset_mm, 20.0, 0.25) << u.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace articula

@@ -134,12 +134,15 @@ Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, cons
                        double from_mm, double to_mm, const EdgeSearch& search) {
   const Profile p = sampleProfile(volume, origin, direction, from_mm, to_mm + kContrastReachMm, search);
   if (p.value.size() < 3) return {};
+  // A ray through a screw meets the metal's falls first, and they are the
+  // steepest: neither is a bone edge nor sets how steep one must be.
   double steepest = 0;
-  for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n) steepest = std::min(steepest, p.slope[n]);
+  for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n)
+    if (p.slope[n] < steepest && edgeAt(p, n).inside_hu <= kMetalHu) steepest = p.slope[n];
   for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n) {
     if (!isFallingMinimum(p, n) || p.slope[n] > kRelativeStrength * steepest) continue;
     Edge e = edgeAt(p, n);
-    if (!strongEnough(e, search)) continue;
+    if (!strongEnough(e, search) || e.inside_hu > kMetalHu) continue;
     e.found = true;
     return e;
   }

@@ -59,7 +59,7 @@ constexpr double kOutsideWarn = 0.02, kOutsideFail = 0.25;
 // Metal near the head: voxels above 2,500 HU (cortical bone reaches about
 // 2,000) within two radii of its centre, warned from 100 mm^3 (a screw of
 // 6 mm by 5 mm; at 3 mm voxels partial volume leaves a screw's core only).
-constexpr double kMetalHu = 2500, kMetalReachRadii = 2, kMetalWarnMm3 = 100;
+constexpr double kMetalReachRadii = 2, kMetalWarnMm3 = 100;  // metal: above imaging::kMetalHu
 // The bone departs from the selected model over its cap (cap_departures.hpp):
 // the largest region beyond the threshold and 2 mm deep, a hip's fovea
 // aside. Warned from 40 mm^2: a dome flattened by a tenth of a 20 mm radius
@@ -261,7 +261,7 @@ double metalNearHead(const imaging::Volume& ct, const Eigen::Vector3d& center, d
   for (int k = std::max(0, int(std::floor(lo.z()))); k <= std::min(g.size[2] - 1, int(std::ceil(hi.z()))); ++k)
     for (int j = std::max(0, int(std::floor(lo.y()))); j <= std::min(g.size[1] - 1, int(std::ceil(hi.y()))); ++j)
       for (int i = std::max(0, int(std::floor(lo.x()))); i <= std::min(g.size[0] - 1, int(std::ceil(hi.x()))); ++i)
-        if (ct.at(i, j, k) > kMetalHu && (g.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm() <= reach) ++metal;
+        if (ct.at(i, j, k) > imaging::kMetalHu && (g.toPhysical(Eigen::Vector3d(i, j, k)) - center).norm() <= reach) ++metal;
   return static_cast<double>(metal) * g.spacing.prod();
 }
 
@@ -377,7 +377,7 @@ QcReport checkHead(const HeadQcInput& in) {
   }
   if (in.metal_near_head_mm3) {
     QcCheck metal = grade("metal_near_head_mm3", *in.metal_near_head_mm3, kMetalWarnMm3, std::nullopt, false,
-                          "metal near the head: the volume (mm^3) above " + number(kMetalHu) + " HU within " +
+                          "metal near the head: the volume (mm^3) above " + number(imaging::kMetalHu) + " HU within " +
                               number(kMetalReachRadii) + " radii of its centre is");
     metal.of_structure = false;
     if (metal.status == "warn")

@@ -20,6 +20,10 @@ namespace articula::imaging {
 /// at a point, tells nothing.
 constexpr double kSeparateEdgesMaxVoxelMm = 2.0;
 
+/// Above this, a voxel is metal (a screw, a stem): cortical bone stays
+/// below it. A fall from metal is the metal's edge, never the bone's.
+constexpr double kMetalHu = 2500;
+
 /// HU at a physical LPS point by trilinear interpolation; NaN outside the grid.
 double interpolate(const Volume& volume, const Eigen::Vector3d& x);
 
