@@ -252,11 +252,12 @@ namespace {
 /// eroded dome whose gap to the socket the segmentation's closing bridged
 /// (the label keeps the round head there, up to a quarter of its radius
 /// above the bone). The first fall met going out from kLabelOutsideReachMm
-/// inside is taken then, if the way from it to x stays out of bone (below
-/// the middle of that fall), so that no edge within the bone is taken.
+/// inside is taken then, if the way from it to x and a millimetre beyond
+/// stays out of bone (below the middle of that fall), so that no edge within
+/// the bone is taken.
 imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, const Eigen::Vector3d& u,
                        const imaging::EdgeSearch& search, bool look_further) {
-  constexpr double kLabelOutsideReachMm = 7.0;
+  constexpr double kLabelOutsideReachMm = 7.0, kBeyondLabelMm = 1.0;
   const imaging::Edge e = imaging::locateEdge(ct, x, u, search);
   if (!look_further || (e.found && e.offset_mm <= search.outward_mm - 0.15)) return e;
   const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
@@ -272,8 +273,11 @@ imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, cons
   imaging::Edge below = imaging::firstEdgeAlongRay(ct, x - kLabelOutsideReachMm * u, u, 0.0, kLabelOutsideReachMm, search);
   below.offset_mm -= kLabelOutsideReachMm;
   if (!below.found || below.offset_mm > -search.inward_mm) return e;
+  // Out of bone from the fall to x and a millimetre beyond: a label cut
+  // inside a faint cortex lies in textured cancellous bone, whose small falls
+  // this would take, with the cortex just outside.
   const double middle = 0.5 * (below.inside_hu + below.outside_hu);
-  for (double t = below.offset_mm + 0.5; t <= 0; t += 0.1)
+  for (double t = below.offset_mm + 0.5; t <= kBeyondLabelMm; t += 0.1)
     if (!(imaging::interpolate(ct, x + t * u) < middle)) return e;
   return below;
 }
