@@ -120,11 +120,6 @@ TEST_F(Runner, ASecondRunSkipsEveryStage) {
   EXPECT_EQ(upToDate(second), kAll);
   EXPECT_TRUE(ran(second).empty());
   EXPECT_EQ(fileText(run.output / "results.json"), results);
-
-  // Forced: every stage again.
-  pipeline::SubjectRun forced = run;
-  forced.force = true;
-  EXPECT_EQ(ran(pipeline::runSubject(forced)), kAll);
 }
 
 TEST_F(Runner, AChangedStageOptionRerunsThatStageAndTheLaterOnes) {
@@ -171,8 +166,8 @@ TEST_F(Runner, FromAndUntilBoundTheStagesRun) {
   EXPECT_EQ(upToDate(again), (Names{"fit"}));
 }
 
-TEST_F(Runner, AMissingOrChangedFileReruns) {
-  pipeline::SubjectRun run = phantomRun("files");
+TEST_F(Runner, AMissingOrDamagedOutputRerunsItsStage) {
+  pipeline::SubjectRun run = phantomRun("outputs");
   ASSERT_EQ(ran(pipeline::runSubject(run)), kAll);
   // A missing output: its stage reruns and writes the same points, so the
   // stages after it are up to date.
@@ -180,6 +175,7 @@ TEST_F(Runner, AMissingOrChangedFileReruns) {
   fs::remove(run.output / "points.ply");
   const pipeline::RunRecord missing = pipeline::runSubject(run);
   EXPECT_EQ(ran(missing), (Names{"sample"}));
+  EXPECT_EQ(upToDate(missing), (Names{"segment", "mesh", "fit", "errors", "report"}));
   EXPECT_EQ(fileText(run.output / "points.ply"), points);
   // A damaged output: its stage reruns, and the stages that read its
   // outputs, since fits.json records the fit's time.
@@ -187,9 +183,22 @@ TEST_F(Runner, AMissingOrChangedFileReruns) {
   const pipeline::RunRecord damaged = pipeline::runSubject(run);
   EXPECT_EQ(upToDate(damaged), (Names{"segment", "mesh", "sample"}));
   EXPECT_EQ(ran(damaged), (Names{"fit", "errors", "report"}));
-  // Another CT (a larger head) at the same path: every stage reruns.
+}
+
+TEST_F(Runner, AnotherCtOrForceRerunsTheStages) {
+  pipeline::SubjectRun run = phantomRun("ct");
+  run.until = "mesh";  // the stages that read the CT
+  const Names both = {"segment", "mesh"};
+  ASSERT_EQ(ran(pipeline::runSubject(run)), both);
+  ASSERT_EQ(upToDate(pipeline::runSubject(run)), both);
+  const std::string label = fileText(run.output / "label.nii.gz");
+  // Another CT (a larger head) at the same path.
   writePhantomCt(run.input, 26.0);
-  EXPECT_EQ(ran(pipeline::runSubject(run)), kAll);
+  EXPECT_EQ(ran(pipeline::runSubject(run)), both);
+  EXPECT_NE(fileText(run.output / "label.nii.gz"), label);
+  pipeline::SubjectRun forced = run;
+  forced.force = true;
+  EXPECT_EQ(ran(pipeline::runSubject(forced)), both);
 }
 
 }  // namespace
