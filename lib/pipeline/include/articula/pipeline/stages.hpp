@@ -2,10 +2,11 @@
 // The pipeline's stages in run order, in one table: what each stage reads
 // and writes in a subject's folder, its command line there, and the options
 // a user may give for it through `articula run`, a batch manifest column or
-// the Snakemake workflow (declared in stage_options.hpp). `articula run`
-// chains the stages from it, `articula stages --json` prints it, and
-// pipelines/Snakefile makes one rule per stage from that print. Adding a
-// stage: its command in apps/, one row here, its options there.
+// the Snakemake workflow (declared in stage_options.hpp). The runner
+// (runner.hpp, `articula run`) chains the stages from it, `articula stages
+// --json` prints it, and pipelines/Snakefile makes one rule per stage from
+// that print. Adding a stage: its command in apps/, one row here, its
+// options there.
 #include <filesystem>
 #include <string>
 #include <vector>
