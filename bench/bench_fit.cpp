@@ -11,7 +11,7 @@
 #include <nlopt.hpp>
 
 #include "articula/distance/signed_distance.hpp"
-#include "articula/fit/algebraic_start.hpp"
+#include "articula/geometry/algebraic_fit.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/testsupport/synthetic_cap.hpp"
 #include "articula/geometry/surface.hpp"
@@ -77,7 +77,7 @@ BENCHMARK_CAPTURE(BM_FitHierarchy, global_CRS2_then_LM, std::string("LM"), artic
 void BM_ThesisBaselineEsch(benchmark::State& state) {
   const Eigen::MatrixX3d& pts = headPoints();
   const ShapeParameters start =
-      articula::geometry::promote(articula::fit::algebraicEllipsoid(pts), ShapeModel::Superovoid);
+      articula::geometry::promote(articula::geometry::algebraicEllipsoid(pts), ShapeModel::Superovoid);
   const Eigen::VectorXd x0 = articula::geometry::toVector(start);
   const auto names = articula::geometry::parameterNames(ShapeModel::Superovoid);
   std::vector<double> lo(x0.size()), hi(x0.size());

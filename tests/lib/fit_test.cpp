@@ -10,7 +10,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/parallel.hpp"
 #include "articula/distance/signed_distance.hpp"
-#include "articula/fit/algebraic_start.hpp"
+#include "articula/geometry/algebraic_fit.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/levenberg_marquardt.hpp"
 #include "articula/fit/parameter_gradient.hpp"
@@ -71,13 +71,13 @@ int fittedAxisAlong(const Eigen::Matrix3d& fitted, const Eigen::Vector3d& axis) 
 TEST(AlgebraicStart, SphereAndEllipsoidExactOnExactPoints) {
   const ShapeParameters e = trueShape(ShapeModel::Ellipsoid);
   const Eigen::MatrixX3d pts = articula::fit::syntheticCap(e, 1.2, 400, 0.0, 1);
-  const ShapeParameters fit = articula::fit::algebraicEllipsoid(pts);
+  const ShapeParameters fit = articula::geometry::algebraicEllipsoid(pts);
   EXPECT_LT((fit.center - e.center).norm(), 1e-6);
   Eigen::Vector3d r = fit.radii, rt = e.radii;
   std::sort(r.data(), r.data() + 3);
   std::sort(rt.data(), rt.data() + 3);
   EXPECT_LT((r - rt).norm(), 1e-6);
-  const ShapeParameters s = articula::fit::algebraicSphere(articula::fit::syntheticCap(trueShape(ShapeModel::Sphere), 1.0, 300, 0.0, 1));
+  const ShapeParameters s = articula::geometry::algebraicSphere(articula::fit::syntheticCap(trueShape(ShapeModel::Sphere), 1.0, 300, 0.0, 1));
   EXPECT_NEAR(s.radii[0], 23.0, 1e-9);
   EXPECT_LT((s.center - Vector3d(-35.0, 12.0, 160.0)).norm(), 1e-9);
 }

@@ -15,7 +15,7 @@
 #include "articula/core/log.hpp"
 #include "articula/core/parallel.hpp"
 #include "articula/distance/signed_distance.hpp"
-#include "articula/fit/algebraic_start.hpp"
+#include "articula/geometry/algebraic_fit.hpp"
 #include "articula/fit/levenberg_marquardt.hpp"
 #include "articula/fit/parameter_gradient.hpp"
 #include "articula/geometry/pose.hpp"
@@ -746,10 +746,10 @@ struct AlgebraicStarts {
 
 AlgebraicStarts algebraicStarts(const Eigen::MatrixX3d& points) {
   AlgebraicStarts a;
-  a.sphere = algebraicSphere(points);
+  a.sphere = geometry::algebraicSphere(points);
   a.ellipsoid = geometry::promote(a.sphere, ShapeModel::Ellipsoid);
   try {
-    const ShapeParameters e = algebraicEllipsoid(points);
+    const ShapeParameters e = geometry::algebraicEllipsoid(points);
     // Reject an algebraic ellipsoid that is far from the data's scale (a flat cap).
     const double r = a.sphere.radii[0];
     if (e.radii.maxCoeff() < 3.0 * r && e.radii.minCoeff() > r / 3.0) {

@@ -17,7 +17,7 @@
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
 #include "articula/distance/signed_distance.hpp"
-#include "articula/fit/algebraic_start.hpp"
+#include "articula/geometry/algebraic_fit.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/mesh_components.hpp"
 #include "articula/geometry/sphere_fit.hpp"
@@ -79,7 +79,7 @@ std::vector<int> ellipsoidBand(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d
   geometry::ShapeParameters ellipsoid;
   std::optional<distance::SignedDistance> fitted;
   try {
-    ellipsoid = fit::algebraicEllipsoid(rowsOf(V, patch));
+    ellipsoid = geometry::algebraicEllipsoid(rowsOf(V, patch));
     if (!(ellipsoid.radii.maxCoeff() < 4 * ellipsoid.radii.minCoeff())) return patch;  // not a head's shape
     fitted.emplace(ellipsoid);
   } catch (const Error&) {

@@ -1,4 +1,4 @@
-#include "articula/fit/algebraic_start.hpp"
+#include "articula/geometry/algebraic_fit.hpp"
 
 #include <complex>
 #include <limits>
@@ -9,13 +9,11 @@
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/sphere_fit.hpp"
 
-namespace articula::fit {
+namespace articula::geometry {
 
 using Eigen::Matrix3d;
 using Eigen::MatrixXd;
 using Eigen::Vector3d;
-using geometry::ShapeModel;
-using geometry::ShapeParameters;
 
 namespace {
 // Centred and scaled copy of the points, for conditioning.
@@ -38,7 +36,7 @@ Normalised normalise(const Eigen::MatrixX3d& points) {
 }  // namespace
 
 ShapeParameters algebraicSphere(const Eigen::MatrixX3d& points) {
-  const geometry::Sphere sphere = geometry::fitSphere(points);
+  const Sphere sphere = fitSphere(points);
   ShapeParameters p;
   p.model = ShapeModel::Sphere;
   p.center = sphere.center;
@@ -106,8 +104,8 @@ ShapeParameters algebraicEllipsoid(const Eigen::MatrixX3d& points) {
   if (R.col(2).dot(cap) < 0.0) R.col(2) *= -1.0;
   R.col(1) = R.col(2).cross(R.col(0));
   p.radii = Vector3d(radii[ix], radii[iy], radii[iz]);
-  p.angles = geometry::anglesFromRotation(R);
+  p.angles = anglesFromRotation(R);
   return p;
 }
 
-}  // namespace articula::fit
+}  // namespace articula::geometry
