@@ -37,6 +37,28 @@ imaging::Volume flatCortex(const Cortex& c, const Eigen::Vector3d& n, double pla
   return v;
 }
 
+/// An n^3 grid of spacing h centred on the origin, each voxel hu(its centre).
+template <class F>
+imaging::Volume cubeAboutOrigin(int n, double h, F hu) {
+  imaging::Volume v;
+  v.geometry.size = Eigen::Vector3i(n, n, n);
+  v.geometry.spacing = Eigen::Vector3d::Constant(h);
+  v.geometry.origin = Eigen::Vector3d::Constant(-0.5 * (n - 1) * h);
+  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) v.at(i, j, k) = static_cast<float>(hu(v.geometry.toPhysical(Eigen::Vector3d(i, j, k))));
+  return v;
+}
+
+constexpr double kSigma = 0.6;  // the rays' heads' radial blur
+/// A head of radius 20 mm with a 1.5 mm cortex over cancellous bone, in soft
+/// tissue, blurred radially: HU at r from its centre.
+double headHu(double r) {
+  const double head = 350 + 950 * Phi((r - 18.5) / kSigma);  // cancellous, then the cortex
+  return 40 + (head - 40) * Phi((20 - r) / kSigma);
+}
+
 TEST(Edges, InterpolationIsExactOnLinearFieldsAndNanOutside) {
   imaging::Volume v;
   v.geometry.size = Eigen::Vector3i(5, 6, 7);
@@ -103,22 +125,11 @@ TEST(Edges, NoEdgeWithoutContrastOrOutsideTheGrid) {
 TEST(Edges, FirstEdgeAlongARayIsTheHeadNotTheSocketBehindANarrowGap) {
   // Head: a ball of radius 20 with a 1.5 mm cortex; socket: a shell from
   // 21.5 to 26.5 mm (a 1.5 mm gap), all blurred radially.
-  imaging::Volume v;
-  const double h = 0.7;
-  v.geometry.size = Eigen::Vector3i(90, 90, 90);
-  v.geometry.spacing = Eigen::Vector3d::Constant(h);
-  v.geometry.origin = Eigen::Vector3d::Constant(-44.5 * h);
-  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
-  const double sigma = 0.6;
-  for (int k = 0; k < 90; ++k)
-    for (int j = 0; j < 90; ++j)
-      for (int i = 0; i < 90; ++i) {
-        const double r = v.geometry.toPhysical(Eigen::Vector3d(i, j, k)).norm();
-        const double head = 350 + 950 * Phi((r - 18.5) / sigma);  // cancellous, then the cortex
-        const double inside = 40 + (head - 40) * Phi((20 - r) / sigma);
-        const double socket = 1260 * (Phi((r - 21.5) / sigma) - Phi((r - 26.5) / sigma));
-        v.at(i, j, k) = static_cast<float>(inside + socket);
-      }
+  const imaging::Volume v = cubeAboutOrigin(90, 0.7, [](const Eigen::Vector3d& x) {
+    const double r = x.norm();
+    const double socket = 1260 * (Phi((r - 21.5) / kSigma) - Phi((r - 26.5) / kSigma));
+    return headHu(r) + socket;
+  });
   for (const Eigen::Vector3d& u : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 1).normalized(),
                                    Eigen::Vector3d(-0.2, 0.5, -0.8).normalized()}) {
     const imaging::Edge e = imaging::firstEdgeAlongRay(v, Eigen::Vector3d::Zero(), u, 6.0, 30.0, {});
@@ -132,26 +143,14 @@ TEST(Edges, FirstEdgeAlongARayIsTheHeadNotTheSocketBehindANarrowGap) {
 // steepest on them, and the first. The ray's edge is the head's cortex all
 // the same.
 TEST(Edges, FirstEdgeAlongARayIsTheBoneNotAScrewInIt) {
-  imaging::Volume v;
-  const double h = 0.7;
-  v.geometry.size = Eigen::Vector3i(70, 70, 70);
-  v.geometry.spacing = Eigen::Vector3d::Constant(h);
-  v.geometry.origin = Eigen::Vector3d::Constant(-34.5 * h);
-  v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
-  const double sigma = 0.6;
   const Eigen::Vector3d axis = Eigen::Vector3d(1, 0.3, -0.2).normalized();
-  for (int k = 0; k < 70; ++k)
-    for (int j = 0; j < 70; ++j)
-      for (int i = 0; i < 70; ++i) {
-        const Eigen::Vector3d x = v.geometry.toPhysical(Eigen::Vector3d(i, j, k));
-        const double r = x.norm(), from_axis = (x - x.dot(axis) * axis).norm();
-        const double head = 350 + 950 * Phi((r - 18.5) / sigma);
-        const double bone = 40 + (head - 40) * Phi((20 - r) / sigma);
-        // From outside the bone at -25 mm to its tip 10 mm beyond the centre.
-        const double screw =
-            Phi((3.25 - from_axis) / sigma) * Phi((x.dot(axis) + 25) / sigma) * Phi((10 - x.dot(axis)) / sigma);
-        v.at(i, j, k) = static_cast<float>(bone + (3071 - bone) * screw);
-      }
+  const imaging::Volume v = cubeAboutOrigin(70, 0.7, [&](const Eigen::Vector3d& x) {
+    const double bone = headHu(x.norm()), from_axis = (x - x.dot(axis) * axis).norm();
+    // From outside the bone at -25 mm to its tip 10 mm beyond the centre.
+    const double screw =
+        Phi((3.25 - from_axis) / kSigma) * Phi((x.dot(axis) + 25) / kSigma) * Phi((10 - x.dot(axis)) / kSigma);
+    return bone + (3071 - bone) * screw;
+  });
   // Past its tip (its fall at 10 mm), across it (at 3.25 mm) and aslant.
   for (const Eigen::Vector3d& u : {axis, Eigen::Vector3d(axis.cross(Eigen::Vector3d::UnitZ()).normalized()),
                                    Eigen::Vector3d(0, 1, 1).normalized()}) {
