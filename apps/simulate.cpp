@@ -15,11 +15,29 @@
 #include "articula/core/provenance.hpp"
 #include "articula/dynamics/scene.hpp"
 #include "articula/dynamics/simulate.hpp"
+#include "articula/report/line_chart_svg.hpp"
 
 namespace articula::apps {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The simulation's figures, beside its tables.
+const std::vector<std::string> kFigures = {"trajectory.svg", "contact_forces.svg", "steps.svg"};
+
+std::vector<report::LineSeries> lines(const std::vector<dynamics::TimeSeries>& series) {
+  std::vector<report::LineSeries> out;
+  for (const auto& s : series) out.push_back({s.label, s.t, s.value});
+  return out;
+}
+
+void writeFigures(const fs::path& folder, const dynamics::SimulationSeries& series) {
+  const std::string contents[] = {
+      report::lineChartSvg(lines(series.heights), {"Height of each body along -gravity", "time (s)", "height (m)"}),
+      report::lineChartSvg(lines(series.normal_forces), {"Normal contact force", "time (s)", "force (N)"}),
+      report::lineChartSvg(lines({series.step_sizes}), {"Integrator step sizes", "time (s)", "step (s)", true})};
+  for (size_t i = 0; i < kFigures.size(); ++i) writeFileAtomically(folder / kFigures[i], contents[i]);
+}
 
 class SimulateCommand : public cli::Command {
  public:
@@ -35,7 +53,9 @@ class SimulateCommand : public cli::Command {
   int run(const cli::CommonOptions& common) override {
     const fs::path summary_path = output_ / "summary.json";
     std::vector<fs::path> outputs = {summary_path};
-    for (const std::string& name : dynamics::simulationOutputs()) outputs.push_back(output_ / name);
+    std::vector<std::string> written = dynamics::simulationOutputs();
+    written.insert(written.end(), kFigures.begin(), kFigures.end());
+    for (const std::string& name : written) outputs.push_back(output_ / name);
     refuseOutputsOverInputs(outputs, {scene_path_});
     if (!common.force && fs::exists(summary_path))
       throw UsageError("refusing to overwrite " + summary_path.string() + " (use --force)");
@@ -44,11 +64,13 @@ class SimulateCommand : public cli::Command {
     fs::remove(summary_path);  // until the new one is written, the folder is unfinished
     log::info("simulating " + std::to_string(scene.bodies.size()) + " bodies, " + std::to_string(scene.contacts.size()) +
               " contacts, " + std::to_string(scene.duration) + " s");
+    dynamics::SimulationSeries series;
     const dynamics::SimulationSummary s = dynamics::simulateScene(
-        scene, output_, [&](double t) { log::progress("simulate", t / scene.duration); });
+        scene, output_, [&](double t) { log::progress("simulate", t / scene.duration); }, &series);
+    writeFigures(output_, series);
     nlohmann::json summary = s.toJson();
     summary["scene"] = scene_path_.string();
-    summary["outputs"] = dynamics::simulationOutputs();
+    summary["outputs"] = written;
     // The scene by its path and SHA-256 (provenance's inputs), not a copy.
     summary["provenance"] = provenanceJson({{}, {scene_path_}, -1});
     summary["provenance"]["coordinate_system"] = "the scene's (z up when gravity is -z)";

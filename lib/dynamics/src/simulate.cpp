@@ -12,7 +12,6 @@
 #include "articula/core/number_text.hpp"
 #include "articula/dynamics/compliant_contact.hpp"
 #include "articula/geometry/pose.hpp"
-#include "articula/report/line_chart_svg.hpp"
 
 namespace articula::dynamics {
 namespace {
@@ -37,8 +36,7 @@ std::string csvNumber(double v) {
 }  // namespace
 
 const std::vector<std::string>& simulationOutputs() {
-  static const std::vector<std::string> names = {"trajectory.csv", "contacts.csv",       "steps.csv",
-                                                 "trajectory.svg", "contact_forces.svg", "steps.svg"};
+  static const std::vector<std::string> names = {"trajectory.csv", "contacts.csv", "steps.csv"};
   return names;
 }
 
@@ -50,7 +48,7 @@ nlohmann::json SimulationSummary::toJson() const {
 }
 
 SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path& folder,
-                                const std::function<void(double)>& progress) {
+                                const std::function<void(double)>& progress, SimulationSeries* series) {
   const auto wall_start = std::chrono::steady_clock::now();
   SimTK::MultibodySystem system;
   SimTK::SimbodyMatterSubsystem matter(system);
@@ -122,13 +120,17 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
   std::string steps = "time_s,step_s\n";
   SimulationSummary summary;
   summary.min_step = std::numeric_limits<double>::infinity();
-  // The figures: each body's height along gravity, each contact's normal
-  // force (NaN while apart), every step's size.
-  std::vector<report::LineSeries> heights(bodies.size()), normal_forces(scene.contacts.size());
+  // What the figures show: each body's height along gravity, each contact's
+  // normal force (NaN while apart), every step's size.
+  SimulationSeries drawn;
+  std::vector<TimeSeries>& heights = drawn.heights;
+  std::vector<TimeSeries>& normal_forces = drawn.normal_forces;
+  TimeSeries& step_sizes = drawn.step_sizes;
+  heights.resize(bodies.size());
+  normal_forces.resize(scene.contacts.size());
   for (size_t i = 0; i < bodies.size(); ++i) heights[i].label = scene.bodies[i].name;
   for (size_t k = 0; k < scene.contacts.size(); ++k)
     normal_forces[k].label = "contact " + std::to_string(k) + " (" + scene.bodies[static_cast<size_t>(scene.contacts[k].body)].name + ")";
-  report::LineSeries step_sizes{"step", {}, {}};
   const Eigen::Vector3d up = g > 0 ? Eigen::Vector3d(-scene.gravity / g) : Eigen::Vector3d::UnitZ();
   const auto writeRow = [&](const SimTK::State& s) {
     system.realize(s, SimTK::Stage::Dynamics);
@@ -136,8 +138,8 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
     for (size_t i = 0; i < bodies.size(); ++i) {
       const SimTK::MobilizedBody& body = bodies[i];
       const SimTK::Transform& X = body.getBodyTransform(s);
-      heights[i].x.push_back(s.getTime());
-      heights[i].y.push_back(up.dot(Eigen::Vector3d(X.p()[0], X.p()[1], X.p()[2])));
+      heights[i].t.push_back(s.getTime());
+      heights[i].value.push_back(up.dot(Eigen::Vector3d(X.p()[0], X.p()[1], X.p()[2])));
       const SimTK::Quaternion q = X.R().convertRotationToQuaternion();
       const SimTK::SpatialVec& V = body.getBodyVelocity(s);
       for (double v : {X.p()[0], X.p()[1], X.p()[2], q[0], q[1], q[2], q[3], V[1][0], V[1][1], V[1][2], V[0][0], V[0][1],
@@ -149,8 +151,8 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
     const auto forces_now = contact.forces(s);
     for (size_t k = 0; k < forces_now.size(); ++k) {
       const contact::ContactForce& f = forces_now[k];
-      normal_forces[k].x.push_back(s.getTime());
-      normal_forces[k].y.push_back(f.normal > 0 ? f.normal : NAN);
+      normal_forces[k].t.push_back(s.getTime());
+      normal_forces[k].value.push_back(f.normal > 0 ? f.normal : NAN);
       if (!(f.normal > 0)) continue;
       contacts += csvNumber(s.getTime()) + "," + std::to_string(k) + "," + csvNumber(f.depth) + "," + csvNumber(f.normal) + "," + csvNumber(f.friction_tb.x()) + "," +
                   csvNumber(f.friction_tb.y()) + "," + csvNumber(f.point.x()) + "," + csvNumber(f.point.y()) + "," +
@@ -171,8 +173,8 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
       summary.min_step = std::min(summary.min_step, h);
       summary.max_step = std::max(summary.max_step, h);
       steps += csvNumber(integrator->getTime()) + "," + csvNumber(h) + "\n";
-      step_sizes.x.push_back(integrator->getTime());
-      step_sizes.y.push_back(h);
+      step_sizes.t.push_back(integrator->getTime());
+      step_sizes.value.push_back(h);
     } else if (status == SimTK::Integrator::ReachedReportTime) {
       summary.energy_end = writeRow(integrator->getState());
       if (integrator->getTime() >= scene.duration) break;
@@ -190,14 +192,9 @@ SimulationSummary simulateScene(const Scene& scene, const std::filesystem::path&
   if (summary.steps == 0) summary.min_step = 0;
   summary.contact_evaluations = contact.counters().evaluations;
   // In the order of simulationOutputs().
-  const std::string contents[] = {
-      trajectory,
-      contacts,
-      steps,
-      report::lineChartSvg(heights, {"Height of each body along -gravity", "time (s)", "height (m)"}),
-      report::lineChartSvg(normal_forces, {"Normal contact force", "time (s)", "force (N)"}),
-      report::lineChartSvg({step_sizes}, {"Integrator step sizes", "time (s)", "step (s)", true})};
+  const std::string contents[] = {trajectory, contacts, steps};
   for (size_t i = 0; i < simulationOutputs().size(); ++i) writeFileAtomically(folder / simulationOutputs()[i], contents[i]);
+  if (series) *series = std::move(drawn);
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return summary;
 }
