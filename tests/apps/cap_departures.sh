@@ -4,7 +4,7 @@
 # selected model over the flattened part deeper than the threshold (for a
 # cap cut by a plane, area grows with depth: the truth's area times
 # (depth - threshold) / depth), superiorly, and the check warns; the same
-# head unflattened departs nowhere by 2 mm, and the check passes.
+# head unflattened departs nowhere by the finding depth, and the check passes.
 source "$(dirname "$0")/common.bash"
 for shape in flat plain; do
   extra=()

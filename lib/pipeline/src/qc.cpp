@@ -8,6 +8,7 @@
 #include "articula/core/error.hpp"
 #include "articula/geometry/fibonacci.hpp"
 #include "articula/imaging/edges.hpp"
+#include "articula/pipeline/cap_departures.hpp"
 
 namespace articula::pipeline {
 namespace {
@@ -392,7 +393,7 @@ QcReport checkHead(const HeadQcInput& in) {
     // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
     QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
                             "the bone departs from the selected model over part of its cap: the largest region "
-                            "departing by 2 mm or more (mm^2, a hip's fovea aside) is");
+                            "departing by " + number(kFindingDepthMm) + " mm or more (mm^2, a hip's fovea aside) is");
     departs.of_structure = false;
     if (departs.status == "warn")
       departs.reason += ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone "
