@@ -3,16 +3,14 @@
 # exit 1, the good subjects complete and correct, failures listed with reasons;
 # a rerun resumes without redoing anything; Snakemake (local profile) gives
 # the same study.csv as articula batch; the same seed gives identical outputs.
-# fixtures: sphere
 # labels: full-size
 source "$(dirname "$0")/common.bash"
 src=${ARTICULA_SOURCE:?}
 
-# p1 at 1.2 mm in-plane voxels (the steepest fall): the test is of the study, not the surface.
+# Both subjects at 1.2 mm in-plane voxels (the steepest fall): the test is of
+# the study, not of the surface. p2 is read as a DICOM series.
 "$bin/articula" phantom -o "$tmp/data/p1" --seed 3 --model ellipsoid --spacing 1.2,1.2,1.5 --no-dicom --quiet
-# p2: the seed-5 sphere phantom, made once for several tests.
-mkdir -p "$tmp/data"
-cp -r "${ARTICULA_FIXTURES:?}/sphere/phantom" "$tmp/data/p2"
+"$bin/articula" phantom -o "$tmp/data/p2" --seed 5 --model sphere --spacing 1.2,1.2,1.5 --quiet
 mkdir -p "$tmp/data/bad-dicom"
 echo "not a DICOM file" > "$tmp/data/bad-dicom/IM0001"
 cat > "$tmp/study.csv" <<CSV
