@@ -31,6 +31,10 @@ fs::path scratch(const std::string& name) {
 void write(const fs::path& path, const std::string& text) {
   std::ofstream(path) << text;
 }
+std::string readText(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 // Brute force: enumerate all 2^n sign assignments of the (average) ranks.
 double bruteForceWilcoxonP(const std::vector<double>& x, const std::vector<double>& y) {
@@ -241,8 +245,7 @@ TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
               .dump());
   }
   p::writeStudyTables(dir, subjects, batch, nlohmann::json::object());
-  std::ifstream in(dir / "study.svg");
-  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string svg = readText(dir / "study.svg");
   auto has = [&](const std::string& s) { return svg.find(s) != std::string::npos; };
   EXPECT_TRUE(has("<title>s2 sphere: 0.5 mm</title>"));
   EXPECT_TRUE(has("<title>s1 ellipsoid: 0.1 mm</title>"));
@@ -255,8 +258,7 @@ TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
   // study.html: a lane per joint and side, the flagged subject ringed and
   // named, the per-model table, and the bound two subjects put on the
   // signed-rank test (2 / 2^2 = 0.5, the smallest p they can give).
-  std::ifstream page_in(dir / "study.html");
-  const std::string page((std::istreambuf_iterator<char>(page_in)), std::istreambuf_iterator<char>());
+  const std::string page = readText(dir / "study.html");
   auto on_page = [&](const std::string& s) { return page.find(s) != std::string::npos; };
   EXPECT_TRUE(on_page("<text class=\"lane\" x=\"4\" y=\"54\">hip, right</text>"));
   EXPECT_TRUE(on_page("<text class=\"lane\" x=\"4\" y=\"98\">hip, left</text>"));
