@@ -21,6 +21,13 @@ using nlohmann::json;
 
 namespace {
 
+std::string hashOnce(const fs::path& path, KnownHashes* known) {
+  if (!known) return hashInput(path);
+  const auto [it, added] = known->try_emplace(path.string());
+  if (added) it->second = hashInput(path);
+  return it->second;
+}
+
 // The table's index of a stage, by name (UsageError naming the stages when none).
 int stageIndex(const std::string& name) {
   const auto& table = stages();
@@ -81,16 +88,17 @@ RunRecord runStages(const SubjectRun& run, Range range) {
     stale += removeStaleTemporaries(folder);
   if (stale > 0) log::info("removed " + std::to_string(stale) + " unfinished file(s) of an interrupted earlier run");
   RunRecord record;
+  KnownHashes known;
   for (int i = range.first; i <= range.last; ++i) {
     const StageDescription& stage = stages()[static_cast<size_t>(i)];
     const StagePlan plan = planStage(run, stage);
     for (const auto& in : plan.inputs)
       if (!fs::exists(in))
         throw InputError("stage " + stage.name + " needs '" + in.string() + "', which is missing: run the earlier stages first");
-    json stamp = stageStamp(plan);
+    json stamp = stageStamp(plan, &known);
     const fs::path stamp_path = stampPath(run.output, stage.name);
     const bool forced = run.force || (!run.from.empty() && i == range.first);
-    if (!forced && isUpToDate(plan, stamp, stamp_path)) {
+    if (!forced && isUpToDate(plan, stamp, stamp_path, &known)) {
       log::info("run: " + stage.name + " is up to date");
       record.stages.push_back({stage.name, StageOutcome::UpToDate, 0});
       continue;
@@ -116,7 +124,10 @@ RunRecord runStages(const SubjectRun& run, Range range) {
     }
     stamp["seconds"] = seconds;
     stamp["outputs"] = json::object();  // a damaged or replaced output reruns the stage
-    for (const auto& out : plan.outputs) stamp["outputs"][out.string()] = hashInput(out);
+    for (const auto& out : plan.outputs) {
+      known.erase(out.string());  // written anew
+      stamp["outputs"][out.string()] = hashOnce(out, &known);
+    }
     stamp["sidecars"] = json::array();
     for (const auto& file : stageFilesIn(stage, run.output))
       if (std::find(stage.outputs.begin(), stage.outputs.end(), file) == stage.outputs.end())
@@ -183,14 +194,14 @@ std::string hashInput(const fs::path& path) {
   return sha256String(all);
 }
 
-json stageStamp(const StagePlan& plan) {
+json stageStamp(const StagePlan& plan, KnownHashes* known) {
   // Another build of articula reruns every stage: its outputs may differ.
   json stamp = {{"articula", versionString()}, {"args", plan.arguments}, {"inputs", json::object()}};
-  for (const auto& in : plan.inputs) stamp["inputs"][in.string()] = hashInput(in);
+  for (const auto& in : plan.inputs) stamp["inputs"][in.string()] = hashOnce(in, known);
   return stamp;
 }
 
-bool isUpToDate(const StagePlan& plan, const json& stamp, const fs::path& stamp_path) {
+bool isUpToDate(const StagePlan& plan, const json& stamp, const fs::path& stamp_path, KnownHashes* known) {
   for (const auto& out : plan.outputs)
     if (!fs::exists(out)) return false;
   const std::optional<json> old = readJsonFileIfValid(stamp_path);
@@ -200,7 +211,7 @@ bool isUpToDate(const StagePlan& plan, const json& stamp, const fs::path& stamp_
           old->at("inputs") == stamp.at("inputs")))
       return false;
     for (const auto& out : plan.outputs)
-      if (old->at("outputs").value(out.string(), "") != hashInput(out)) return false;
+      if (old->at("outputs").value(out.string(), "") != hashOnce(out, known)) return false;
     return true;
   } catch (const json::exception&) {
     return false;

@@ -67,14 +67,22 @@ void checkSubjectRun(const SubjectRun& run);
 /// SHA-256 of a file, or of every file of a folder (a DICOM series) in name order.
 std::string hashInput(const std::filesystem::path& path);
 
+/// Hashes already taken in one run, by path: the run holds its folder's lock,
+/// so a file it hashed (the CT, a stage's output) is not changed under it,
+/// and each is read once rather than by every stage that takes it.
+using KnownHashes = std::map<std::string, std::string>;
+
 /// The stamp a stage of this plan would leave: the articula build, its
-/// arguments and its inputs' hashes (the inputs must exist).
-nlohmann::json stageStamp(const StagePlan& plan);
+/// arguments and its inputs' hashes (the inputs must exist); `known`, when
+/// given, supplies hashes taken before and keeps those taken now.
+nlohmann::json stageStamp(const StagePlan& plan, KnownHashes* known = nullptr);
 
 /// Whether the stage need not run: its outputs exist, and the stamp it left
 /// at `stamp_path` names the same build, arguments and input hashes as
-/// `stamp` (stageStamp) and the outputs' present hashes.
-bool isUpToDate(const StagePlan& plan, const nlohmann::json& stamp, const std::filesystem::path& stamp_path);
+/// `stamp` (stageStamp) and the outputs' present hashes (through `known`, as
+/// stageStamp).
+bool isUpToDate(const StagePlan& plan, const nlohmann::json& stamp, const std::filesystem::path& stamp_path,
+                KnownHashes* known = nullptr);
 
 /// Where a stage's stamp is kept in the subject's folder.
 std::filesystem::path stampPath(const std::filesystem::path& output, const std::string& stage);
