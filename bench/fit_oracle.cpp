@@ -26,6 +26,7 @@
 
 #include "articula/core/parallel.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
+#include "articula/testsupport/run_all.hpp"
 #include "articula/testsupport/synthetic_cap.hpp"
 #include "articula/geometry/shape.hpp"
 
@@ -33,6 +34,7 @@ namespace {
 
 using articula::geometry::ShapeModel;
 using articula::geometry::ShapeParameters;
+using articula::testsupport::runAll;
 
 double threadCpuSeconds() {
   timespec t{};
@@ -55,18 +57,6 @@ struct Case {
 struct Outcome {
   double exact_rms = 0, noisy_rms = 0, reference_rms = 0, cpu_seconds = 0;
 };
-
-// Runs `work(i)` for i in [0, n) on `jobs` threads (each fit on one thread).
-template <class Work>
-void runAll(int n, int jobs, Work work) {
-  std::atomic<int> next{0};
-  std::vector<std::thread> threads;
-  for (int j = 0; j < jobs; ++j)
-    threads.emplace_back([&] {
-      for (int i = next++; i < n; i = next++) work(i);
-    });
-  for (auto& t : threads) t.join();
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

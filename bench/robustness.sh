@@ -10,8 +10,9 @@
 # the head or its surface warned: not only the side's) or SILENTLY WRONG
 # (exit 0, not correct, no such warning). Prints a markdown table of the
 # shares per spacing group and one row per head, then the selected model against the true model (a confusion
-# matrix); writes WORK/robustness.md and WORK/robustness.json.
-#   bash bench/robustness.sh [-j N] [--quick] [--ids g0-00,g0-03] [--run-args '--edge-model cortex'] [build/bin] [WORK]
+# matrix, against the drawn model and against the simplest model the drawn
+# surface is); writes WORK/robustness.md and WORK/robustness.json.
+#   bash bench/robustness.sh [-j N] [--quick] [--fresh] [--ids g0-00,g0-03] [--run-args '--edge-model cortex'] [build/bin] [WORK]
 # Needs build/bin/articula and build/bin/bench-score-head (the scorer).
 set -euo pipefail
 jobs=2 quick=() extra=()
@@ -21,6 +22,7 @@ while (($#)); do
     -j) jobs=$2; shift 2 ;;
     -j*) jobs=${1#-j}; shift ;;
     --quick) quick=(--quick); shift ;;
+    --fresh) extra+=(--fresh); shift ;;
     --ids) extra+=(--ids "$2"); shift 2 ;;
     --run-args) extra+=(--run-args "$2"); shift 2 ;;
     *) args+=("$1"); shift ;;

@@ -8,7 +8,9 @@
 // RESULTS.json, centre_error_mm (results' head_center_mm to the true centre).
 // Used by bench/robustness.py and bench/clinical.py.
 // ARTICULA_SCORE_POINTS=FILE also writes each point's x,y,z,signed distance
-// (mm) as CSV, to see where a head goes wrong.
+// (mm) as CSV, to see where a head goes wrong; ARTICULA_SCORE_TRUE_POINTS=FILE
+// writes each point's closest point on the head's model as x,y,z CSV (exact
+// data on the run's cap: what the true shape differs from simpler models by).
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -43,16 +45,24 @@ int main(int argc, char** argv) {
     const articula::distance::SignedDistance exact(hip.head);
     const articula::points::PointCloud cloud = articula::points::readPoints(argv[3]);
     const Eigen::Index n = cloud.positions.rows();
-    std::ofstream per_point;
+    std::ofstream per_point, true_points;
     if (const char* file = std::getenv("ARTICULA_SCORE_POINTS")) {
       per_point.open(file);
       per_point << "x,y,z,signed_mm\n";
+    }
+    if (const char* file = std::getenv("ARTICULA_SCORE_TRUE_POINTS")) {
+      true_points.open(file);
+      true_points.precision(17);
+      true_points << "x,y,z\n";
     }
     double sum = 0, sum2 = 0, max_abs = 0, model2 = 0;
     long within = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Vector3d x = cloud.positions.row(i).transpose();
-      const double to_model = exact.closest(x).distance;
+      const articula::distance::ClosestPoint closest = exact.closest(x);
+      const double to_model = closest.distance;
+      if (true_points.is_open())
+        true_points << closest.point.x() << ',' << closest.point.y() << ',' << closest.point.z() << '\n';
       const double d = articula::phantom::headSurfaceDistance(hip, to_model, x);
       model2 += to_model * to_model;
       if (per_point.is_open()) per_point << x.x() << ',' << x.y() << ',' << x.z() << ',' << d << '\n';

@@ -19,7 +19,7 @@ by = {s["name"]: s for s in stages}
 options = {s["name"]: [o["name"] for o in s["options"]] for s in stages}
 assert "series-uid" in options["segment"] and "series-uid" in options["mesh"]
 assert "smoothing" in options["mesh"], by["mesh"]
-assert options["report"] == ["series-uid", "selection-alpha"], by["report"]
+assert options["report"] == ["series-uid", "selection-alpha", "selection-length"], by["report"]
 assert by["report"]["outputs"] == ["results.json", "results.csv", "head.mrk.json", "report.html", "scene.mrml"]
 assert "CT" in by["mesh"]["inputs"]
 # Every stage's command line names the files it reads and the first it writes
@@ -103,8 +103,9 @@ for m in r["models"]:
         assert re.search(r'id="semi-axes">' + r'(?: &plusmn; [0-9.]+)?, '.join("%.2f" % x for x in axes), html), "semi-axes not shown"
 assert 'class="status %s"' % r["qc"]["status"] in html
 # The selection's evidence: the hierarchy's five steps, each a nested F test
-# with the two models' n_eff, and the walk that chose the model; on the
-# page as a table; the least-RMS model named only where it is another.
+# with the points' n_eff at the selection's correlation length, and the walk
+# that chose the model; on the page as a table; the least-RMS model named
+# only where it is another.
 sel = r["selection"]
 assert [(st["simpler"], st["richer"]) for st in sel["steps"]] == [
     ("sphere", "ellipsoid"), ("ellipsoid", "superellipsoid"), ("ellipsoid", "ovoid"),
@@ -112,9 +113,11 @@ assert [(st["simpler"], st["richer"]) for st in sel["steps"]] == [
 by_model = {m["model"]: m for m in r["models"]}
 for st in sel["steps"] + sel["path"]:
     assert 0 <= st["p_value"] <= 1 and st["f"] >= 0 and st["richer_needed"] == (st["p_value"] < st["alpha"]), st
-    both = by_model[st["simpler"]]["residual_correlation"]["n_eff"] * by_model[st["richer"]]["residual_correlation"]["n_eff"]
-    assert abs(st["n_eff"] - both ** 0.5) < 1e-6 * st["n_eff"], st  # the geometric mean of the two models' n_eff
+    assert st["n_eff"] == sel["n_eff"], st  # one count of the points for every test
     assert 1 <= st["n_eff"] <= by_model[st["richer"]]["errors"]["n_points"], st
+# Errors shared over 4 mm leave a cap of this head (R about 23 mm) some tens
+# of independent points: about its area over 2 pi L^2.
+assert sel["length_mm"] == 4 and 20 <= sel["n_eff"] <= 150, sel["n_eff"]
 assert sel["path"] and sel["path"][0]["simpler"] == "sphere", sel["path"]
 # The walk ends where no richer model passes: the selected model's own tests all fail.
 assert not any(st["richer_needed"] for st in sel["path"] if st["simpler"] == selected), sel["path"]

@@ -503,6 +503,21 @@ TEST(ResidualCorrelation, RecoversTheCorrelationLengthOfKnownFields) {
   EXPECT_GT(c.n_eff, 0.8 * cap.rows());
 }
 
+// The points' effective number at a given length against the brute-force
+// sum over every pair (the cells' approximation within 3 %); n at length 0;
+// on a hemisphere of 23 mm about its area over 2 pi L^2 (within 30 %: the
+// rim's points have fewer neighbours).
+TEST(ResidualCorrelation, EffectivePointsAtALengthMatchTheSumOverPairs) {
+  const Eigen::MatrixX3d cap = articula::fit::syntheticCap(trueShape(ShapeModel::Sphere), 90.0 * M_PI / 180.0, 1500, 0.0, 1);
+  for (double length : {1.0, 4.0}) {
+    const double exact = trueEffectivePoints(cap, length);
+    EXPECT_NEAR(articula::fit::nEffectiveAtLength(cap, length), exact, 0.03 * exact) << "L " << length;
+    const double area = 2.0 * M_PI * 23.0 * 23.0;
+    EXPECT_NEAR(exact, area / (2.0 * M_PI * length * length), 0.3 * area / (2.0 * M_PI * length * length)) << "L " << length;
+  }
+  EXPECT_EQ(articula::fit::nEffectiveAtLength(cap, 0.0), 1500.0);
+}
+
 // Intervals on caps whose errors neighbouring points share (an ellipsoid,
 // 300 points, a field of 0.1 mm and correlation length 4 mm): with the
 // residuals' correlation (the default) the 95 % intervals of the centre and

@@ -61,6 +61,13 @@ double fitAtLengths(const std::vector<double>& h, const std::vector<double>& gam
 
 }  // namespace
 
+double nEffectiveAtLength(const Eigen::MatrixX3d& points, double length_mm) {
+  const auto n = static_cast<double>(points.rows());
+  if (!(length_mm > 0) || points.rows() == 0) return n;
+  const double sum = exponentialGram(points, Eigen::MatrixXd::Ones(points.rows(), 1), length_mm)(0, 0);
+  return sum > 0 ? std::min(n, n * n / sum) : n;
+}
+
 double nEffective(const ResidualCorrelation& c, double covariance_sum) {
   return covariance_sum > 0 ? static_cast<double>(c.n) * static_cast<double>(c.n) * c.variance() / covariance_sum
                             : static_cast<double>(c.n);

@@ -184,6 +184,11 @@ const std::map<std::string, std::vector<StageOption>>& declarations() {
                   "Level of the nested tests that take a richer model (with the residuals' correlation; 0: always "
                   "the sphere)")
                .in(0, 0.5),
+           option("selection-length", FIELD(report.selection_length_mm),
+                  "Length over which the nested tests count the surface's errors as shared (0: each fit's own "
+                  "residual correlation)")
+               .in(0, 50)
+               .unitIs("mm"),
        }},
   };
   return table;

@@ -192,7 +192,9 @@ std::string selectionTable(const json& results) {
   std::string html = "<h3>Model selection</h3>\n<p class=\"note\">Each step tests whether the richer model's extra "
                      "parameters are needed: F = (fall of the SSE per extra parameter) / (the richer model's residual "
                      "variance) &times; n<sub>eff</sub> / n, so that correlated points count as the independent points they "
-                     "are worth. A model the points do not determine is never selected.</p>\n"
+                     "are worth (n<sub>eff</sub>: the cap's points for errors shared over " +
+                     fixed(numberAt(selection, "length_mm"), 1) +
+                     " mm; 0 mm: from each fit's residuals). A model the points do not determine is never selected.</p>\n"
                      "<table id=\"selection-steps\"><tr><th>step</th><th>F</th><th>df</th><th>n<sub>eff</sub></th>"
                      "<th>p</th><th>level</th><th>richer model needed</th></tr>\n";
   const auto rows = [&](const json& steps, const std::string& kind) {
@@ -286,8 +288,12 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
     << selected << " was selected by nested F tests along the hierarchy at a level of "
     << fixed(numberAt(selection, "alpha"), 2)
     << " (Bonferroni-corrected over the richer models tested at each step), each counting the points as the "
-       "effective number of independent points their residuals' spatial correlation (a variogram with a nugget and "
-       "two exponential scales) leaves; models whose parameters the points did not determine took no part";
+    << (numberAt(selection, "length_mm") > 0
+            ? "effective number of independent points of the cap for errors shared over " +
+                  fixed(numberAt(selection, "length_mm"), 1) + " mm (" + fixed(numberAt(selection, "n_eff"), 0) + ")"
+            : std::string("effective number of independent points their residuals' spatial correlation (a variogram "
+                          "with a nugget and two exponential scales) leaves"))
+    << "; models whose parameters the points did not determine took no part";
   if (m) {
     const json& parameters = member(*m, "parameters");
     p << "; its RMS error was " << fixed(numberAt(member(*m, "errors"), "rms_mm"), 2) << " mm and its centre lay at ("

@@ -17,6 +17,7 @@
 #include "articula/core/number_text.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/fit/fits_json.hpp"
+#include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/shape.hpp"
 #include "articula/core/csv.hpp"
@@ -285,7 +286,12 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     }
     models.push_back(entry);
   }
-  // The model these points support (see selectNested).
+  // The model these points support (see selectNested), the points counted as
+  // the cap's effective number at the surface's correlation length.
+  const double selection_n_eff = o.selection_length_mm > 0
+                                     ? fit::nEffectiveAtLength(points::readPoints(o.folder / "points.ply").positions,
+                                                               o.selection_length_mm)
+                                     : NAN;
   std::vector<ModelEvidence> evidence;
   for (size_t i = 0; i < models.size(); ++i) {
     const json& m = models[i];
@@ -295,7 +301,9 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
     e.n_parameters = m.at("n_parameters");
     e.n_points = m.at("errors").value("n_points", fits.value("n_points", 0));
     e.sse_mm2 = m.at("errors").value("sse_mm2", fit_entry.value("geometric_objective_mm2", NAN));
-    if (fit_entry.contains("residual_correlation") && fit_entry.at("residual_correlation").is_object())
+    if (std::isfinite(selection_n_eff))
+      e.n_eff = selection_n_eff;
+    else if (fit_entry.contains("residual_correlation") && fit_entry.at("residual_correlation").is_object())
       e.n_eff = fit_entry.at("residual_correlation").value("n_eff", NAN);
     e.determined = determinedByPoints(shapes[i].model, m.value("not_identifiable", json::array()));
     evidence.push_back(e);
@@ -383,7 +391,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   provenance.parameters = {{"joint", o.joint},
                            {"side", o.side},
                            {"input", o.ct.string()},
-                           {"selection_alpha", o.selection_alpha}};
+                           {"selection_alpha", o.selection_alpha},
+                           {"selection_length_mm", o.selection_length_mm}};
   const json results = {
       {"input", o.ct.string()},
       {"joint", o.joint},
@@ -394,10 +403,12 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
        {{"rule",
          "among the models the points determine (not undetermined), from the sphere: every model containing the "
          "current one is tested against it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "
-         "n_eff the geometric mean of the two models' effective numbers of independent points) at alpha / their "
-         "number; the simplest "
-         "that passes becomes the current model, until none passes"},
+         "n_eff the points' effective number of independent points for errors correlated over length_mm; with "
+         "length_mm 0, the geometric mean of the two models' from their residuals) at alpha / their number; the "
+         "simplest that passes becomes the current model, until none passes"},
         {"alpha", o.selection_alpha},
+        {"length_mm", o.selection_length_mm},
+        {"n_eff", std::isfinite(selection_n_eff) ? json(selection_n_eff) : json(nullptr)},
         {"steps", steps_json},
         {"path", path_json},
         {"undetermined", selection.undetermined}}},

@@ -59,6 +59,11 @@ ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, 
 /// every pair of n points (1^T Sigma 1).
 double nEffective(const ResidualCorrelation& c, double covariance_sum);
 
+/// n_eff of `points` for errors wholly correlated as exp(-h / length_mm):
+/// n^2 / sum_ij exp(-|x_i - x_j| / L) (about the cap's area over 2 pi L^2
+/// on a cap much wider than L; n for L = 0).
+double nEffectiveAtLength(const Eigen::MatrixX3d& points, double length_mm);
+
 /// sum_i sum_j k(|x_i - x_j|) a_i a_j^T (#m x #m; a_i the rows of `a`, k(0)
 /// included), for a kernel that vanishes beyond `reach_mm`. Pairs are taken
 /// cell by cell (cells of `cell_mm`, at least 1/48 of the extent): between

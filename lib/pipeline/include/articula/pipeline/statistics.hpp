@@ -39,8 +39,11 @@ double bic(double sse, int n, int k);
 /// The test of a simpler model against a richer one that contains it is the
 /// F test of the fall of the sum of squared distances with an effective
 /// number of independent points n_eff, the geometric mean of the two
-/// models' (the simpler model's residuals count the richer model's gain as
-/// correlated noise, the richer model's have absorbed part of the noise):
+/// models' ModelEvidence::n_eff (the report stage gives every model the
+/// points' n_eff at the selection's correlation length, subject_report.hpp;
+/// with length 0, each fit's own from its residuals, where the simpler
+/// model's count the richer model's gain as correlated noise and the richer
+/// model's have absorbed part of the noise):
 ///   F = ((SSE_s - SSE_r) / (k_r - k_s)) / (SSE_r / (n - k_r)) x n_eff / n,
 /// on (k_r - k_s, n - k_r) degrees of freedom. A smooth error field (blur,
 /// partial volume, anisotropic voxels) projects onto a richer model's extra

@@ -15,6 +15,15 @@ namespace articula::pipeline {
 // Default of --selection-alpha: the level of the nested tests of the model
 // selection (pipeline::selectNested).
 constexpr double kDefaultSelectionAlpha = 0.05;
+// Default of --selection-length: the length over which the nested tests count
+// a CT surface's errors as shared (mm). A fit's own residuals cannot tell it:
+// over a cap they hold the shape a model misses and the slices' direction-
+// dependent error, which a variogram takes for lengths of 5-50 mm, while the
+// surface's making (blur, the mesh's and the edge model's smoothing over
+// about 3 mm) ties neighbours over a few millimetres. Measured on phantom
+// CTs of known shape (docs/benchmarks.md, model selection): 3.5-4.5 mm
+// select best, from 0.6 to 3 mm voxels alike.
+constexpr double kDefaultSelectionLengthMm = 4.0;
 
 struct SubjectReportOptions {
   std::filesystem::path folder;  // holds fits.json, errors/summary.json, points.ply (and label.nii.gz.json)
@@ -22,6 +31,7 @@ struct SubjectReportOptions {
   std::string series_uid;        // the CT's series, in a DICOM folder of several
   std::string joint = "hip", side = "right";
   double selection_alpha = kDefaultSelectionAlpha;
+  double selection_length_mm = kDefaultSelectionLengthMm;  // 0: each fit's own residual correlation
   long long seed = -1;           // recorded in the provenance
 };
 

@@ -1,0 +1,133 @@
+// The model selection on caps whose errors neighbouring points share
+// (docs/benchmarks.md, "Model selection on caps with correlated errors"): for
+// each true model of the hierarchy, caps of random head-like shapes
+// (testsupport::randomHeadShape, radii within 6 % of each other) with a
+// Gaussian error field along the normal of correlation length 0-5 mm and
+// 0.05-0.2 mm, caps of half-angle 60-120 degrees about the shape's local z,
+// 1,000 points; each fitted
+// with the hierarchy and selected by pipeline::selectNested at 0.05 with
+//   - the points' n_eff at the selection's length (the report's default, 4 mm),
+//   - each fit's own residual correlation (--selection-length 0).
+// Prints one JSON line per cap (true model, the length, the noise, the
+// departure of the truth from the nearest simpler model on its exact cap,
+// the two selections), then per rule and true model the share right, the
+// share richer than the truth (the test's false positives) and the share
+// simpler or beside it (an ovoid for a superellipsoid).
+// Every cap is seeded: a line is reproduced from its seed.
+//   bench-selection-caps [--caps 200] [--jobs 2] [--seed 1] [--length 4]
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "articula/core/parallel.hpp"
+#include "articula/fit/fit_hierarchy.hpp"
+#include "articula/fit/residual_correlation.hpp"
+#include "articula/geometry/shape.hpp"
+#include "articula/pipeline/statistics.hpp"
+#include "articula/testsupport/run_all.hpp"
+#include "articula/testsupport/synthetic_cap.hpp"
+
+namespace {
+
+using articula::geometry::ShapeModel;
+
+// The evidence selectNested weighs, each model's points counted as n_eff
+// (NaN: the fit's own residual correlation).
+std::vector<articula::pipeline::ModelEvidence> evidence(const articula::fit::Summary& s, double n_eff) {
+  std::vector<articula::pipeline::ModelEvidence> out;
+  for (const auto& f : s.fits) {
+    articula::pipeline::ModelEvidence e;
+    e.model = articula::geometry::modelName(f.parameters.model);
+    e.n_parameters = articula::geometry::parameterCount(f.parameters.model);
+    e.n_points = s.points;
+    e.sse_mm2 = f.sse_mm2;
+    e.n_eff = std::isfinite(n_eff) ? n_eff : f.uncertainty.correlation.n_eff;
+    for (const auto& name : f.uncertainty.not_identifiable)
+      if (name != "phi" && name != "theta" && name != "psi") e.determined = false;
+    out.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"The model selection on caps with correlated errors"};
+  int caps = 200, jobs = 2, points = 1000;
+  unsigned seed = 1;
+  double length_mm = 4.0;
+  app.add_option("--caps", caps, "Caps per true model");
+  app.add_option("--jobs", jobs, "Caps fitted at once (each on one thread)")->check(CLI::PositiveNumber);
+  app.add_option("--seed", seed, "Base seed of every cap");
+  app.add_option("--length", length_mm, "The selection's correlation length (mm)");
+  app.add_option("--points", points, "Points per cap");
+  CLI11_PARSE(app, argc, argv);
+  articula::setWorkerThreads(1);
+
+  const auto& models = articula::geometry::allModels();
+  const int total = caps * static_cast<int>(models.size());
+  std::vector<nlohmann::json> lines(static_cast<size_t>(total));
+  std::mutex print;
+  articula::testsupport::runAll(total, jobs, [&](int i) {
+    const ShapeModel model = models[static_cast<size_t>(i / caps)];
+    const unsigned cap_seed = seed * 1000003u + static_cast<unsigned>(i);
+    std::mt19937 rng(cap_seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double length = 5.0 * u(rng), sigma = 0.05 + 0.15 * u(rng), half_angle_deg = 60.0 + 60.0 * u(rng);
+    const auto truth = articula::fit::randomHeadShape(model, 0.06, cap_seed);
+    const double half_angle = half_angle_deg * M_PI / 180.0;
+    const Eigen::MatrixX3d noisy = length > 0.05
+                                       ? articula::fit::correlatedCap(truth, half_angle, points, sigma, length, cap_seed)
+                                       : articula::fit::syntheticCap(truth, half_angle, points, sigma, cap_seed);
+    nlohmann::json line = {{"seed", cap_seed}, {"true", articula::geometry::modelName(model)}, {"length_mm", length},
+                           {"sigma_mm", sigma}, {"half_angle_deg", half_angle_deg}};
+    try {
+      // The truth's departure from each simpler model: their fits to its exact cap.
+      const articula::fit::Summary exact = articula::fit::fitHierarchy(articula::fit::syntheticCap(truth, half_angle, points, 0.0, cap_seed));
+      double departure = INFINITY;
+      for (const auto& f : exact.fits)
+        if (f.parameters.model != model && articula::geometry::contains(model, f.parameters.model))
+          departure = std::min(departure, std::sqrt(f.sse_mm2 / exact.points));
+      line["departure_mm"] = std::isfinite(departure) ? nlohmann::json(departure) : nlohmann::json(nullptr);
+      const articula::fit::Summary s = articula::fit::fitHierarchy(noisy);
+      const double n_eff = articula::fit::nEffectiveAtLength(noisy, length_mm);
+      line["n_eff"] = n_eff;
+      line["at_length"] = articula::pipeline::selectNested(evidence(s, n_eff)).selected;
+      line["per_fit"] = articula::pipeline::selectNested(evidence(s, NAN)).selected;
+    } catch (const std::exception& e) {
+      line["error"] = e.what();
+    }
+    std::lock_guard<std::mutex> lock(print);
+    std::cout << line.dump() << std::endl;
+    lines[static_cast<size_t>(i)] = line;
+  });
+
+  // Per rule and true model: right, richer than the truth, simpler.
+  for (const char* rule : {"at_length", "per_fit"}) {
+    std::printf("\n%s (%s):\n| true | caps | right | richer | simpler or beside |\n|---|---|---|---|---|\n", rule,
+                std::string(rule) == "at_length" ? ("n_eff at " + std::to_string(length_mm).substr(0, 4) + " mm").c_str()
+                                                 : "each fit's own residual correlation");
+    for (ShapeModel model : models) {
+      int n = 0, right = 0, richer = 0, simpler = 0;
+      for (const auto& line : lines) {
+        if (line.value("true", "") != articula::geometry::modelName(model) || !line.contains(rule)) continue;
+        const ShapeModel chosen = articula::geometry::modelFromName(line[rule].get<std::string>());
+        ++n;
+        right += chosen == model;
+        richer += chosen != model && articula::geometry::contains(chosen, model);
+        simpler += chosen != model && !articula::geometry::contains(chosen, model);
+      }
+      std::printf("| %s | %d | %.1f %% | %.1f %% | %.1f %% |\n", articula::geometry::modelName(model).c_str(), n,
+                  100.0 * right / std::max(n, 1), 100.0 * richer / std::max(n, 1), 100.0 * simpler / std::max(n, 1));
+    }
+  }
+  return 0;
+}
