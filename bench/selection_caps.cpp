@@ -10,7 +10,7 @@
 //   - each fit's own residual correlation (--selection-length 0).
 // Prints one JSON line per cap (true model, the length, the noise, the
 // departure of the truth from the nearest simpler model on its exact cap,
-// the two selections), then per rule and true model the share right, the
+// each model's RMS, the true model's fitted from the truth, the two selections), then per rule and true model the share right, the
 // share richer than the truth (the test's false positives) and the share
 // simpler or beside it (an ovoid for a superellipsoid).
 // Every cap is seeded: a line is reproduced from its seed.
@@ -69,14 +69,18 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Base seed of every cap");
   app.add_option("--length", length_mm, "The selection's correlation length (mm)");
   app.add_option("--points", points, "Points per cap");
+  std::string only;
+  app.add_option("--true", only, "Only caps of this true model (their seeds unchanged)");
   CLI11_PARSE(app, argc, argv);
   articula::setWorkerThreads(1);
 
   const auto& models = articula::geometry::allModels();
   const int total = caps * static_cast<int>(models.size());
+  const int first = only.empty() ? 0 : caps * static_cast<int>(articula::geometry::modelFromName(only));
   std::vector<nlohmann::json> lines(static_cast<size_t>(total));
   std::mutex print;
-  articula::testsupport::runAll(total, jobs, [&](int i) {
+  articula::testsupport::runAll(only.empty() ? total : caps, jobs, [&](int k) {
+    const int i = first + k;
     const ShapeModel model = models[static_cast<size_t>(i / caps)];
     const unsigned cap_seed = seed * 1000003u + static_cast<unsigned>(i);
     std::mt19937 rng(cap_seed);
@@ -98,6 +102,10 @@ int main(int argc, char** argv) {
           departure = std::min(departure, std::sqrt(f.sse_mm2 / exact.points));
       line["departure_mm"] = std::isfinite(departure) ? nlohmann::json(departure) : nlohmann::json(nullptr);
       const articula::fit::Summary s = articula::fit::fitHierarchy(noisy);
+      for (const auto& f : s.fits)
+        line["rms_mm"][articula::geometry::modelName(f.parameters.model)] = std::sqrt(f.sse_mm2 / s.points);
+      // The truth's own RMS on these points: a fit of the true model above it has stopped short of its optimum.
+      line["truth_rms_mm"] = std::sqrt(articula::fit::fitFrom(truth, noisy).sse_mm2 / s.points);
       const double n_eff = articula::fit::nEffectiveAtLength(noisy, length_mm);
       line["n_eff"] = n_eff;
       line["at_length"] = articula::pipeline::selectNested(evidence(s, n_eff)).selected;

@@ -103,7 +103,7 @@ for m in r["models"]:
         assert re.search(r'id="semi-axes">' + r'(?: &plusmn; [0-9.]+)?, '.join("%.2f" % x for x in axes), html), "semi-axes not shown"
 assert 'class="status %s"' % r["qc"]["status"] in html
 # The selection's evidence: the hierarchy's five steps, each a nested F test
-# with the points' n_eff at the selection's correlation length, and the walk
+# with the points' n_eff at the selection's correlation length, and the tests
 # that chose the model; on the page as a table; the least-RMS model named
 # only where it is another.
 sel = r["selection"]
@@ -119,7 +119,7 @@ for st in sel["steps"] + sel["path"]:
 # of independent points: about its area over 2 pi L^2.
 assert sel["length_mm"] == 4 and 20 <= sel["n_eff"] <= 150, sel["n_eff"]
 assert sel["path"] and sel["path"][0]["simpler"] == "sphere", sel["path"]
-# The walk ends where no richer model passes: the selected model's own tests all fail.
+# No richer model beats the selected one: its own tests all fail.
 assert not any(st["richer_needed"] for st in sel["path"] if st["simpler"] == selected), sel["path"]
 assert selected not in sel["undetermined"]
 assert html.count('<tr class="step">') == 5 and html.count('<tr class="path">') == len(sel["path"]), "selection table"

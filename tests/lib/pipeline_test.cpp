@@ -338,6 +338,30 @@ TEST(ModelSelection, CohortTestsOfPerSubjectSteps) {
   EXPECT_NEAR(pipeline::cohortStep({0.01, 0.01, 0.01, 0.5, 0.5}, {true, true, true, false, false}).sign_test_p, 0.5, 1e-12);
 }
 
+// Both of the ellipsoid's children are needed over it, and the superovoid
+// adds to the superellipsoid (p 0.038) but nothing to the ovoid (p 0.94):
+// the ovoid is the simplest model nothing beats. (Moving on to the simplest
+// child that passes, the superellipsoid, would have reached the superovoid
+// without testing it against the ovoid.)
+TEST(ModelSelection, TheSimplestModelNoRicherOneBeats) {
+  const std::vector<pipeline::ModelEvidence> models = {{"sphere", 4, 2000, 50.0, 40, true},
+                                                       {"ellipsoid", 9, 2000, 10.0, 40, true},
+                                                       {"superellipsoid", 12, 2000, 7.0, 40, true},
+                                                       {"ovoid", 17, 2000, 5.0, 40, true},
+                                                       {"superovoid", 20, 2000, 4.95, 40, true}};
+  const pipeline::ModelSelection s = pipeline::selectNested(models);
+  EXPECT_EQ(s.selected, "ovoid");
+  EXPECT_TRUE(s.steps[1].richer_needed);   // ellipsoid -> superellipsoid
+  EXPECT_TRUE(s.steps[2].richer_needed);   // ellipsoid -> ovoid
+  EXPECT_TRUE(s.steps[3].richer_needed);   // superellipsoid -> superovoid
+  EXPECT_FALSE(s.steps[4].richer_needed);  // ovoid -> superovoid
+  // The tests made: the sphere against 4 models, the ellipsoid against 3,
+  // the superellipsoid and the ovoid against the superovoid.
+  ASSERT_EQ(s.path.size(), 9u);
+  EXPECT_EQ(s.path.back().simpler, "ovoid");
+  EXPECT_FALSE(s.path.back().richer_needed);
+}
+
 // Exact caps of each model of the hierarchy (head-like shapes whose
 // departures from the parent are clear: radii 25/22/20 mm, exponents
 // 2.2-2.6, egg terms c1 0.05-0.08) with errors that neighbouring points

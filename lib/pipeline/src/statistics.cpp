@@ -1,6 +1,7 @@
 #include "articula/pipeline/statistics.hpp"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <numeric>
 
@@ -142,33 +143,49 @@ ModelSelection selectNested(const std::vector<ModelEvidence>& models, double alp
                                                                             {"superellipsoid", "superovoid"},
                                                                             {"ovoid", "superovoid"}})
     if (named(s) && named(r)) out.steps.push_back(nestedFTest(*named(s), *named(r), alpha));
-  // Start at the simplest candidate; walk while a richer one passes.
-  const ModelEvidence* current = nullptr;
+  // Every candidate against each candidate containing it, at alpha / the
+  // number of those. A model is supported when it is the simplest or needed
+  // over every supported model it contains; the selected one is the
+  // simplest supported model that no model containing it beats.
+  // (A walk that moved on to the simplest richer model passing its test
+  // could reach the superovoid through the superellipsoid where the ovoid
+  // was enough, never testing the superovoid against the ovoid.)
+  std::vector<const ModelEvidence*> order;
   for (const auto& m : models)
-    if (candidate(m) && (!current || m.n_parameters < current->n_parameters)) current = &m;
-  if (!current) return out;
-  while (true) {
+    if (candidate(m)) order.push_back(&m);
+  if (order.empty()) return out;
+  std::stable_sort(order.begin(), order.end(),
+                   [](const ModelEvidence* a, const ModelEvidence* b) { return a->n_parameters < b->n_parameters; });
+  const auto within = [&](const ModelEvidence* richer, const ModelEvidence* simpler) {
+    return richer != simpler && richer->n_parameters > simpler->n_parameters && contains(richer->model, simpler->model);
+  };
+  std::map<std::pair<const ModelEvidence*, const ModelEvidence*>, bool> needed;
+  for (const ModelEvidence* simpler : order) {
     std::vector<const ModelEvidence*> richer;
-    for (const auto& m : models)
-      if (candidate(m) && m.model != current->model && m.n_parameters > current->n_parameters &&
-          contains(m.model, current->model))
-        richer.push_back(&m);
-    if (richer.empty()) break;
-    const ModelEvidence* next = nullptr;
-    double next_p = INFINITY;
+    for (const ModelEvidence* m : order)
+      if (within(m, simpler)) richer.push_back(m);
     for (const ModelEvidence* m : richer) {
-      const NestedStep step = nestedFTest(*current, *m, alpha / static_cast<double>(richer.size()));
-      out.path.push_back(step);
-      if (step.richer_needed &&
-          (!next || m->n_parameters < next->n_parameters || (m->n_parameters == next->n_parameters && step.p_value < next_p))) {
-        next = m;
-        next_p = step.p_value;
-      }
+      out.path.push_back(nestedFTest(*simpler, *m, alpha / static_cast<double>(richer.size())));
+      needed[{simpler, m}] = out.path.back().richer_needed;
     }
-    if (!next) break;
-    current = next;
   }
-  out.selected = current->model;
+  std::vector<const ModelEvidence*> supported;
+  for (const ModelEvidence* m : order) {
+    bool over_all = true;
+    for (const ModelEvidence* s : supported) over_all = over_all && (!within(m, s) || needed[{s, m}]);
+    if (supported.empty() || over_all) supported.push_back(m);
+  }
+  for (const ModelEvidence* m : supported) {
+    bool beaten = false;
+    for (const ModelEvidence* r : order) beaten = beaten || (within(r, m) && needed[{m, r}]);
+    if (!beaten) {
+      out.selected = m->model;
+      break;
+    }
+  }
+  // Each supported model beaten by one its Bonferroni level let pass over
+  // it but not over a simpler one: the richest supported.
+  if (out.selected.empty()) out.selected = supported.back()->model;
   return out;
 }
 

@@ -186,7 +186,7 @@ std::string probability(double p) {
 }
 
 // The nested tests of the model selection: the hierarchy's steps, each at
-// alpha, and the walk's tests at their levels.
+// alpha, and the tests the choice made at their levels.
 std::string selectionTable(const json& results) {
   const json& selection = member(results, "selection");
   std::string html = "<h3>Model selection</h3>\n<p class=\"note\">Each step tests whether the richer model's extra "
@@ -200,7 +200,7 @@ std::string selectionTable(const json& results) {
   const auto rows = [&](const json& steps, const std::string& kind) {
     for (const auto& st : steps)
       html += "<tr class=\"" + kind + "\"><td>" + report::escapeMarkup(text(st, "simpler")) + " &rarr; " +
-              report::escapeMarkup(text(st, "richer")) + (kind == "path" ? " (walk)" : "") + "</td><td>" +
+              report::escapeMarkup(text(st, "richer")) + (kind == "path" ? " (choice)" : "") + "</td><td>" +
               fixed(numberAt(st, "f"), 2) + "</td><td>" + text(st, "df1") + ", " + text(st, "df2") + "</td><td>" +
               fixed(numberAt(st, "n_eff"), 0) + "</td><td>" + probability(numberAt(st, "p_value")) + "</td><td>" +
               fixed(numberAt(st, "alpha"), 4) + "</td><td>" + (member(st, "richer_needed") == true ? "yes" : "no") +
@@ -287,7 +287,8 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
        "each from its parent's fit, by least squares of the exact signed Euclidean distances of the points. The "
     << selected << " was selected by nested F tests along the hierarchy at a level of "
     << fixed(numberAt(selection, "alpha"), 2)
-    << " (Bonferroni-corrected over the richer models tested at each step), each counting the points as the "
+    << " (Bonferroni-corrected over the richer models each was tested against): the simplest model needed over "
+       "the simpler ones that no richer model beat. Each test counted the points as the "
     << (numberAt(selection, "length_mm") > 0
             ? "effective number of independent points of the cap for errors shared over " +
                   fixed(numberAt(selection, "length_mm"), 1) + " mm (" + fixed(numberAt(selection, "n_eff"), 0) + ")"

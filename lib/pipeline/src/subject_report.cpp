@@ -401,11 +401,11 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"least_rms_model", best},
       {"selection",
        {{"rule",
-         "among the models the points determine (not undetermined), from the sphere: every model containing the "
-         "current one is tested against it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "
+         "each model the points determine (not undetermined) is tested against every determined model containing it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "
          "n_eff the points' effective number of independent points for errors correlated over length_mm; with "
-         "length_mm 0, the geometric mean of the two models' from their residuals) at alpha / their number; the "
-         "simplest that passes becomes the current model, until none passes"},
+         "length_mm 0, the geometric mean of the two models' from their residuals) at alpha / their number; a model "
+         "is supported when it is the simplest or needed over every supported model it contains; the selected model "
+         "is the simplest supported one that no model containing it beats"},
         {"alpha", o.selection_alpha},
         {"length_mm", o.selection_length_mm},
         {"n_eff", std::isfinite(selection_n_eff) ? json(selection_n_eff) : json(nullptr)},

@@ -51,12 +51,15 @@ double bic(double sse, int n, int k);
 /// denominator's variance comes from all the points. Without the factor
 /// (the plain F test, AIC, BIC) every small gain on a CT surface looks real.
 ///
-/// The walk: from the sphere, every determined model that contains the
-/// current one is tested against it at alpha / (their number)
-/// (Bonferroni); the simplest whose test passes (fewest parameters, then
-/// the smaller p) becomes the current model; the walk ends when none
-/// passes. So a superellipsoid of equal radii is reached from the sphere
-/// although the ellipsoid adds nothing.
+/// The choice: every determined model is tested against each determined
+/// model that contains it, at alpha / (their number) (Bonferroni). A model
+/// is supported when it is the simplest or needed over every supported
+/// model it contains; the selected model is the simplest supported one that
+/// no model containing it beats. So a superellipsoid of equal
+/// radii is chosen over the sphere although the ellipsoid adds nothing, and
+/// an egg-shaped head whose ovoid leaves the superovoid nothing to add is
+/// an ovoid, also where the superellipsoid (fewer parameters, not
+/// containing the ovoid) is needed over the ellipsoid too.
 ///
 /// Only models the points determine take part: one with a centre, radius,
 /// exponent or ovoid term the points leave open (not_identifiable in
@@ -87,7 +90,7 @@ struct ModelSelection {
   std::string selected;
   std::vector<NestedStep> steps;   // the hierarchy's five steps (sphere -> ellipsoid, ellipsoid -> superellipsoid,
                                    // ellipsoid -> ovoid, superellipsoid -> superovoid, ovoid -> superovoid), each at alpha
-  std::vector<NestedStep> path;    // the tests of the walk, in order, at their Bonferroni levels
+  std::vector<NestedStep> path;    // every determined model against each containing it, at their Bonferroni levels
   std::vector<std::string> undetermined;  // left out, in the order given
 };
 /// `models` in any order (names of geometry::modelName); alpha in [0, 1):
