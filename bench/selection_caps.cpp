@@ -1,20 +1,22 @@
 // The model selection on caps whose errors neighbouring points share
-// (docs/benchmarks.md, "Model selection on caps with correlated errors"): for
-// each true model of the hierarchy, caps of random head-like shapes
+// (docs/benchmarks.md, "Model selection on caps with correlated errors"):
+// for each true model of the hierarchy, caps of random head-like shapes
 // (testsupport::randomHeadShape, radii within 6 % of each other) with a
-// Gaussian error field along the normal of correlation length 0-5 mm and
-// 0.05-0.2 mm, caps of half-angle 60-120 degrees about the shape's local z,
-// 1,000 points; each fitted
-// with the hierarchy and selected by pipeline::selectNested at 0.05 with
+// Gaussian error field along the normal of 0.05-0.2 mm and correlation
+// length 0-5 mm, caps of half-angle 60-120 degrees about the shape's local
+// z, 1,000 points; each fitted with the hierarchy and selected by
+// pipeline::selectNested at 0.05 with
 //   - the points' n_eff at the selection's length (the report's default, 4 mm),
 //   - each fit's own residual correlation (--selection-length 0).
-// Prints one JSON line per cap (true model, the length, the noise, the
-// departure of the truth from the nearest simpler model on its exact cap,
-// each model's RMS, the true model's fitted from the truth, the two selections), then per rule and true model the share right, the
-// share richer than the truth (the test's false positives) and the share
-// simpler or beside it (an ovoid for a superellipsoid).
-// Every cap is seeded: a line is reproduced from its seed.
-//   bench-selection-caps [--caps 200] [--jobs 2] [--seed 1] [--length 4]
+// Prints one JSON line per cap (true model, length, noise, the truth's
+// departure from the nearest simpler model on its exact cap, each model's
+// RMS, the true model's fitted from the truth, the models the points leave
+// undetermined, the two selections); then per rule and true model the share
+// right, richer than the truth (the test's false positives) and simpler or
+// beside it (an ovoid for a superellipsoid); and the power: the share right
+// by the truth's departure from its simpler models over the noise. Every
+// cap is seeded: a line is reproduced from its seed.
+//   bench-selection-caps [--caps 200] [--jobs 2] [--seed 1] [--length 4] [--true MODEL]
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -108,7 +110,9 @@ int main(int argc, char** argv) {
       line["truth_rms_mm"] = std::sqrt(articula::fit::fitFrom(truth, noisy).sse_mm2 / s.points);
       const double n_eff = articula::fit::nEffectiveAtLength(noisy, length_mm);
       line["n_eff"] = n_eff;
-      line["at_length"] = articula::pipeline::selectNested(evidence(s, n_eff)).selected;
+      const articula::pipeline::ModelSelection chosen = articula::pipeline::selectNested(evidence(s, n_eff));
+      line["at_length"] = chosen.selected;
+      line["undetermined"] = chosen.undetermined;
       line["per_fit"] = articula::pipeline::selectNested(evidence(s, NAN)).selected;
     } catch (const std::exception& e) {
       line["error"] = e.what();
@@ -136,6 +140,26 @@ int main(int argc, char** argv) {
       std::printf("| %s | %d | %.1f %% | %.1f %% | %.1f %% |\n", articula::geometry::modelName(model).c_str(), n,
                   100.0 * right / std::max(n, 1), 100.0 * richer / std::max(n, 1), 100.0 * simpler / std::max(n, 1));
     }
+  }
+  // Power: the share right of the caps whose truth departs from every
+  // simpler model, by that departure over the noise.
+  std::printf("\npower (true models other than the sphere), by departure / noise:\n| rule | below 0.5 | 0.5-1 | 1-2 | 2 and more |\n"
+              "|---|---|---|---|---|\n");
+  for (const char* rule : {"at_length", "per_fit"}) {
+    const double edges[] = {0.0, 0.5, 1.0, 2.0, INFINITY};
+    std::printf("| %s |", rule);
+    for (int b = 0; b < 4; ++b) {
+      int n = 0, right = 0;
+      for (const auto& line : lines) {
+        if (!line.contains(rule) || !line.contains("departure_mm") || !line["departure_mm"].is_number()) continue;
+        const double ratio = line["departure_mm"].get<double>() / line["sigma_mm"].get<double>();
+        if (ratio < edges[b] || ratio >= edges[b + 1]) continue;
+        ++n;
+        right += line[rule] == line["true"];
+      }
+      std::printf(" %.0f %% of %d |", 100.0 * right / std::max(n, 1), n);
+    }
+    std::printf("\n");
   }
   return 0;
 }
