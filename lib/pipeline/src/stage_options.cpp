@@ -181,8 +181,7 @@ const std::map<std::string, std::vector<StageOption>>& declarations() {
            option("series-uid", FIELD(report.series_uid),
                   "Series Instance UID of the CT in a DICOM folder holding several (for the slices of report.html)"),
            option("selection-alpha", FIELD(report.selection_alpha),
-                  "Level of the nested tests that take a richer model (with the residuals' correlation; 0: always "
-                  "the sphere)")
+                  "Level of the nested tests that take a richer model (0: always the sphere)")
                .in(0, 0.5),
            option("selection-length", FIELD(report.selection_length_mm),
                   "Length over which the nested tests count the surface's errors as shared (0: each fit's own "

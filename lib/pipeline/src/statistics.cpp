@@ -1,8 +1,8 @@
 #include "articula/pipeline/statistics.hpp"
 
 #include <algorithm>
-#include <map>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include <boost/math/distributions/chi_squared.hpp>
