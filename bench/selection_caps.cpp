@@ -104,8 +104,11 @@ int main(int argc, char** argv) {
           departure = std::min(departure, std::sqrt(f.sse_mm2 / exact.points));
       line["departure_mm"] = std::isfinite(departure) ? nlohmann::json(departure) : nlohmann::json(nullptr);
       const articula::fit::Summary s = articula::fit::fitHierarchy(noisy);
-      for (const auto& f : s.fits)
+      for (const auto& f : s.fits) {
         line["rms_mm"][articula::geometry::modelName(f.parameters.model)] = std::sqrt(f.sse_mm2 / s.points);
+        if (!f.uncertainty.not_identifiable.empty())
+          line["not_identifiable"][articula::geometry::modelName(f.parameters.model)] = f.uncertainty.not_identifiable;
+      }
       // The truth's own RMS on these points: a fit of the true model above it has stopped short of its optimum.
       line["truth_rms_mm"] = std::sqrt(articula::fit::fitFrom(truth, noisy).sse_mm2 / s.points);
       const double n_eff = articula::fit::nEffectiveAtLength(noisy, length_mm);
@@ -130,7 +133,8 @@ int main(int argc, char** argv) {
     for (ShapeModel model : models) {
       int n = 0, right = 0, richer = 0, simpler = 0;
       for (const auto& line : lines) {
-        if (line.value("true", "") != articula::geometry::modelName(model) || !line.contains(rule)) continue;
+        if (!line.is_object() || line.value("true", "") != articula::geometry::modelName(model) || !line.contains(rule))
+          continue;
         const ShapeModel chosen = articula::geometry::modelFromName(line[rule].get<std::string>());
         ++n;
         right += chosen == model;

@@ -323,6 +323,12 @@ TEST(ModelSelection, UndeterminedModelsAreNeverSelected) {
   // None determined: all take part.
   for (auto& m : models) m.determined = false;
   EXPECT_EQ(pipeline::selectNested(models).selected, "ovoid");
+  // A superovoid whose own check passed, over an ovoid the points leave
+  // open, is open too: the ellipsoid.
+  for (auto& m : models) m.determined = m.model != "ovoid";
+  s = pipeline::selectNested(models);
+  EXPECT_EQ(s.selected, "ellipsoid");
+  EXPECT_EQ(s.undetermined, (std::vector<std::string>{"ovoid", "superovoid"}));
 }
 
 TEST(ModelSelection, CohortTestsOfPerSubjectSteps) {

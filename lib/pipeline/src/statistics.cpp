@@ -124,12 +124,6 @@ ModelSelection selectNested(const std::vector<ModelEvidence>& models, double alp
       if (m.model == name) return &m;
     return nullptr;
   };
-  const bool any_determined = std::any_of(models.begin(), models.end(), [](const ModelEvidence& m) {
-    return m.determined && std::isfinite(m.sse_mm2);
-  });
-  for (const auto& m : models)
-    if (!m.determined) out.undetermined.push_back(m.model);
-  const auto candidate = [&](const ModelEvidence& m) { return std::isfinite(m.sse_mm2) && (m.determined || !any_determined); };
   const auto contains = [](const std::string& general, const std::string& special) {
     try {
       return geometry::contains(geometry::modelFromName(general), geometry::modelFromName(special));
@@ -137,6 +131,19 @@ ModelSelection selectNested(const std::vector<ModelEvidence>& models, double alp
       return general == special;
     }
   };
+  // A model containing one the points leave open is open too: more
+  // parameters cannot pin down the ones they share (its own check, at
+  // another optimum, may miss that).
+  const auto determined = [&](const ModelEvidence& m) {
+    return std::all_of(models.begin(), models.end(),
+                       [&](const ModelEvidence& o) { return o.determined || !contains(m.model, o.model); });
+  };
+  const bool any_determined = std::any_of(models.begin(), models.end(), [&](const ModelEvidence& m) {
+    return determined(m) && std::isfinite(m.sse_mm2);
+  });
+  for (const auto& m : models)
+    if (!determined(m)) out.undetermined.push_back(m.model);
+  const auto candidate = [&](const ModelEvidence& m) { return std::isfinite(m.sse_mm2) && (determined(m) || !any_determined); };
   for (const auto& [s, r] : std::vector<std::pair<const char*, const char*>>{{"sphere", "ellipsoid"},
                                                                             {"ellipsoid", "superellipsoid"},
                                                                             {"ellipsoid", "ovoid"},

@@ -64,8 +64,9 @@ double bic(double sse, int n, int k);
 /// Only models the points determine take part: one with a centre, radius,
 /// exponent or ovoid term the points leave open (not_identifiable in
 /// fits.json; an open angle, such as a spheroid's spin, is allowed, and an
-/// ovoid's c0x and c0y are a gauge) would report parameters as if measured.
-/// When no model is determined, all take part.
+/// ovoid's c0x and c0y are a gauge) would report parameters as if measured;
+/// nor does a model containing such a one (more parameters cannot pin down
+/// those they share). When no model is determined, all take part.
 struct ModelEvidence {
   std::string model;
   int n_parameters = 0;
