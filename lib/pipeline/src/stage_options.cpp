@@ -112,7 +112,7 @@ const std::map<std::string, std::vector<StageOption>>& declarations() {
                   "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
                   "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
                   "the voxels about the normal, with one point-spread for the CT; 'auto' the cortex model on CTs "
-                  "whose voxels are at most 1 mm within the slices and 3 mm across them, the steepest fall beyond")
+                  "whose voxels are at most 1.5 mm within the slices and 3 mm across them, the steepest fall beyond")
                .oneOf({"auto", "cortex", "steepest"}),
            option("point-spread", FIELD(mesh.edges.point_spread_mm),
                   "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation) within "

@@ -49,10 +49,12 @@ enum class EdgeModel { Automatic, SteepestFall, Cortex };
 /// blurred-cortex model: in-plane voxels up to kCortexModelMaxInPlaneMm and
 /// slices up to kCortexModelMaxSliceMm. There the model's surface lay within
 /// 0.05 mm of the true one on average on 65 of 84 heads of three phantom
-/// generators and within 0.1 mm on 82, thin cortices included, where the
-/// steepest fall lay 0.04-0.42 mm outside (docs/benchmarks.md, "Surface bias
-/// by voxel size"); on coarser in-plane voxels (1.5 mm) it is not measured.
-constexpr double kCortexModelMaxInPlaneMm = 1.0, kCortexModelMaxSliceMm = 3.0;
+/// generators at 0.6-1 mm in-plane and within 0.1 mm on 82, thin cortices
+/// included, where the steepest fall lay 0.04-0.42 mm outside; at 1.2-1.5 mm
+/// in-plane within 0.05 mm on 23 of 28 and within 0.17 on all, where the
+/// steepest fall lay 0.08-1.04 mm outside (docs/benchmarks.md, "Surface bias
+/// by voxel size").
+constexpr double kCortexModelMaxInPlaneMm = 1.5, kCortexModelMaxSliceMm = 3.0;
 
 struct EdgeSnapOptions {
   double search_mm = 0;         // edge search either side of a vertex (0: 1.5 voxels inwards, at least 1.5 mm; a quarter voxel outwards, at least 0.75 mm)
