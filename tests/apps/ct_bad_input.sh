@@ -184,6 +184,11 @@ expect 3 "announces 27648 bytes of voxel data, the file holds 13824: the file is
 expect 3 "compressed voxel data is damaged\|the file is cut short" -- "$B/articula-segment" -i "$T/cut-zlib.mha" -o "$T/l.nii.gz"
 expect 3 "1 of 13824 voxels are not finite numbers" -- "$B/articula-segment" -i "$T/nan.mha" -o "$T/l.nii.gz"
 expect 3 "every voxel holds the same value" -- "$B/articula-segment" -i "$T/flat.mha" -o "$T/l.nii.gz"
+# An NRRD whose size has more digits than any volume (ITK wraps it and
+# allocates what the wrapped size asks for) is refused by name.
+printf 'NRRD0004\ntype: short\ndimension: 3\nsizes: 3333333333333333333333334 4 4\nencoding: raw\n\n' > "$T/huge.nrrd"
+expect 3 "sizes: '3333333333333333333333334 4 4'; expected whole numbers of at most 18 digits" -- \
+  "$B/articula-segment" -i "$T/huge.nrrd" -o "$T/l.nii.gz"
 test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for a damaged MetaImage"; fail=1; }
 # The whole file passes the reader's checks (its ball is too small for a head: exit 1).
 expect 1 "no femoral head found" -- "$B/articula-segment" -i "$T/whole.mha" -o "$T/l.nii.gz"

@@ -238,6 +238,11 @@ void checkNrrd(const fs::path& path) {
   }
   const auto type = kBytes.find(lower(fields["type"]));
   const std::vector<unsigned long long> sizes = sizesOf(fields["sizes"]);
+  // ITK reads a size of more digits than any volume has by wrapping it, and
+  // then allocates what the wrapped size asks for.
+  if (!trimmed(fields["sizes"]).empty() && sizes.empty())
+    throw InputError(path.string() + ": the NRRD header says sizes: '" + excerpt(fields["sizes"], 60) +
+                     "'; expected whole numbers of at most 18 digits");
   const std::string encoding = lower(fields["encoding"]);
   if (type == kBytes.end() || sizes.empty() || fields.count("byte skip") || fields.count("line skip")) return;
   DataLayout data;
