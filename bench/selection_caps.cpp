@@ -37,29 +37,7 @@
 #include "articula/testsupport/run_all.hpp"
 #include "articula/testsupport/synthetic_cap.hpp"
 
-namespace {
-
 using articula::geometry::ShapeModel;
-
-// The evidence selectNested weighs, each model's points counted as n_eff
-// (NaN: the fit's own residual correlation).
-std::vector<articula::pipeline::ModelEvidence> evidence(const articula::fit::Summary& s, double n_eff) {
-  std::vector<articula::pipeline::ModelEvidence> out;
-  for (const auto& f : s.fits) {
-    articula::pipeline::ModelEvidence e;
-    e.model = articula::geometry::modelName(f.parameters.model);
-    e.n_parameters = articula::geometry::parameterCount(f.parameters.model);
-    e.n_points = s.points;
-    e.sse_mm2 = f.sse_mm2;
-    e.n_eff = std::isfinite(n_eff) ? n_eff : f.uncertainty.correlation.n_eff;
-    for (const auto& name : f.uncertainty.not_identifiable)
-      if (name != "phi" && name != "theta" && name != "psi") e.determined = false;
-    out.push_back(e);
-  }
-  return out;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"The model selection on caps with correlated errors"};
@@ -113,10 +91,10 @@ int main(int argc, char** argv) {
       line["truth_rms_mm"] = std::sqrt(articula::fit::fitFrom(truth, noisy).sse_mm2 / s.points);
       const double n_eff = articula::fit::nEffectiveAtLength(noisy, length_mm);
       line["n_eff"] = n_eff;
-      const articula::pipeline::ModelSelection chosen = articula::pipeline::selectNested(evidence(s, n_eff));
+      const articula::pipeline::ModelSelection chosen = articula::pipeline::selectNested(articula::pipeline::modelEvidence(s, n_eff));
       line["at_length"] = chosen.selected;
       line["undetermined"] = chosen.undetermined;
-      line["per_fit"] = articula::pipeline::selectNested(evidence(s, NAN)).selected;
+      line["per_fit"] = articula::pipeline::selectNested(articula::pipeline::modelEvidence(s, NAN)).selected;
     } catch (const std::exception& e) {
       line["error"] = e.what();
     }

@@ -382,16 +382,6 @@ TEST(ModelSelection, TheSimplestModelNoRicherOneBeats) {
 // model nearly every time (measured: 0 right).
 TEST(ModelSelection, SelectsTheTrueModelOfCapsWithCorrelatedErrors) {
   using geometry::ShapeModel;
-  auto evidence = [](const fit::Summary& s, double n_eff) {
-    std::vector<pipeline::ModelEvidence> out;
-    for (const auto& f : s.fits) {
-      out.push_back({geometry::modelName(f.parameters.model), geometry::parameterCount(f.parameters.model), s.points,
-                     f.sse_mm2, std::isfinite(n_eff) ? n_eff : f.uncertainty.correlation.n_eff, true});
-      for (const auto& name : f.uncertainty.not_identifiable)
-        if (name != "phi" && name != "theta" && name != "psi") out.back().determined = false;
-    }
-    return out;
-  };
   int right = 0, richer = 0, per_fit_richer = 0, plain_right = 0;
   for (ShapeModel model : geometry::allModels()) {
     geometry::ShapeParameters truth;
@@ -408,12 +398,12 @@ TEST(ModelSelection, SelectsTheTrueModelOfCapsWithCorrelatedErrors) {
       const Eigen::MatrixX3d pts = fit::correlatedCap(truth, 80.0 * M_PI / 180.0, 700, 0.05, 1.5, seed);
       const fit::Summary s = fit::fitHierarchy(pts);
       const std::string chosen =
-          pipeline::selectNested(evidence(s, fit::nEffectiveAtLength(pts, pipeline::kDefaultSelectionLengthMm))).selected;
+          pipeline::selectNested(pipeline::modelEvidence(s, fit::nEffectiveAtLength(pts, pipeline::kDefaultSelectionLengthMm))).selected;
       right += chosen == geometry::modelName(model);
       richer += chosen != geometry::modelName(model) && geometry::contains(geometry::modelFromName(chosen), model);
-      const std::string per_fit = pipeline::selectNested(evidence(s, NAN)).selected;
+      const std::string per_fit = pipeline::selectNested(pipeline::modelEvidence(s, NAN)).selected;
       per_fit_richer += per_fit != geometry::modelName(model) && geometry::contains(geometry::modelFromName(per_fit), model);
-      plain_right += pipeline::selectNested(evidence(s, static_cast<double>(s.points))).selected == geometry::modelName(model);
+      plain_right += pipeline::selectNested(pipeline::modelEvidence(s, static_cast<double>(s.points))).selected == geometry::modelName(model);
     }
   }
   EXPECT_GE(right, 6);

@@ -92,6 +92,25 @@ WilcoxonResult wilcoxonSignedRank(const std::vector<double>& x, const std::vecto
 double aic(double sse, int n, int k) { return n * std::log(sse / n) + 2.0 * k; }
 double bic(double sse, int n, int k) { return n * std::log(sse / n) + k * std::log(static_cast<double>(n)); }
 
+bool determinedByPoints(geometry::ShapeModel model, const std::vector<std::string>& not_identifiable) {
+  const auto names = geometry::parameterNames(model);
+  const auto kinds = geometry::parameterKinds(model);
+  for (const std::string& name : not_identifiable) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end() || kinds[static_cast<size_t>(it - names.begin())] != geometry::ParameterKind::Angle) return false;
+  }
+  return true;
+}
+
+std::vector<ModelEvidence> modelEvidence(const fit::Summary& fits, double n_eff) {
+  std::vector<ModelEvidence> out;
+  for (const auto& f : fits.fits)
+    out.push_back({geometry::modelName(f.parameters.model), geometry::parameterCount(f.parameters.model), fits.points,
+                   f.sse_mm2, std::isfinite(n_eff) ? n_eff : f.uncertainty.correlation.n_eff,
+                   determinedByPoints(f.parameters.model, f.uncertainty.not_identifiable)});
+  return out;
+}
+
 NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer, double alpha) {
   NestedStep step;
   step.simpler = simpler.model;

@@ -56,21 +56,6 @@ std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
   return unit.empty() ? name : name + "_" + unit;
 }
 
-// Whether the points determine a model's shape and place: none of its
-// parameters among those fits.json calls not identifiable but its angles
-// (a spheroid's spin may be open; its shape is not). An ovoid's c0x and c0y
-// are its gauge (held, fits.json "gauge"), never counted.
-bool determinedByPoints(geometry::ShapeModel model, const json& not_identifiable) {
-  const auto names = geometry::parameterNames(model);
-  const auto kinds = geometry::parameterKinds(model);
-  for (const auto& item : not_identifiable) {
-    const std::string name = item.is_string() ? item.get<std::string>() : "";
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end() || kinds[static_cast<size_t>(it - names.begin())] != geometry::ParameterKind::Angle) return false;
-  }
-  return true;
-}
-
 json stepJson(const NestedStep& s) {
   const auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   return {{"simpler", s.simpler}, {"richer", s.richer},   {"f", finite(s.f)},         {"df1", s.df1},
@@ -94,12 +79,11 @@ json readStageJson(const fs::path& path) {
 
 // The checks of a head (pipeline/qc.hpp) on the articular points, their
 // fitted sphere and the segmentation's own head, where it searched.
-QcReport checkSubjectHead(const fs::path& folder, const std::string& joint,
+QcReport checkSubjectHead(const fs::path& folder, const points::PointCloud& cloud, const std::string& joint,
                           const std::vector<geometry::ShapeParameters>& shapes, const imaging::Volume* ct,
                           const std::optional<CapDepartures>& departures) {
   HeadQcInput in;
   if (departures) in.cap_departure_mm2 = departures->largestFindingMm2();
-  const points::PointCloud cloud = points::readPoints(folder / "points.ply");
   in.points = cloud.positions;
   in.normals = cloud.normals;
   if (ct && in.normals.rows() == in.points.rows()) {
@@ -193,7 +177,7 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volu
 
 // Where the bone's mesh departs from the selected model over the cap
 // (pipeline/cap_departures.hpp); none without the mesh.
-std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const std::optional<points::MeshFile>& bone,
+std::optional<CapDepartures> departuresFromModel(const Eigen::MatrixX3d& points, const std::optional<points::MeshFile>& bone,
                                                  const geometry::ShapeParameters& model, const imaging::Volume* ct,
                                                  const std::string& joint, const std::string& side) {
   if (!bone) return std::nullopt;
@@ -202,7 +186,7 @@ std::optional<CapDepartures> departuresFromModel(const fs::path& folder, const s
   in.vertices = mesh.vertices;
   in.triangles = mesh.triangles;
   in.model = model;
-  in.points = points::readPoints(folder / "points.ply").positions;
+  in.points = points;
   if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
   in.ct = ct;
   // LPS: +x is the patient's left, so a right hip's medial side is +x.
@@ -288,10 +272,9 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   }
   // The model these points support (see selectNested), the points counted as
   // the cap's effective number at the surface's correlation length.
-  const double selection_n_eff = o.selection_length_mm > 0
-                                     ? fit::nEffectiveAtLength(points::readPoints(o.folder / "points.ply").positions,
-                                                               o.selection_length_mm)
-                                     : NAN;
+  const points::PointCloud cloud = points::readPoints(o.folder / "points.ply");
+  const double selection_n_eff =
+      o.selection_length_mm > 0 ? fit::nEffectiveAtLength(cloud.positions, o.selection_length_mm) : NAN;
   std::vector<ModelEvidence> evidence;
   for (size_t i = 0; i < models.size(); ++i) {
     const json& m = models[i];
@@ -305,7 +288,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
       e.n_eff = selection_n_eff;
     else if (fit_entry.contains("residual_correlation") && fit_entry.at("residual_correlation").is_object())
       e.n_eff = fit_entry.at("residual_correlation").value("n_eff", NAN);
-    e.determined = determinedByPoints(shapes[i].model, m.value("not_identifiable", json::array()));
+    // An ovoid's c0x and c0y are its gauge (fits.json "gauge"), never listed as not identifiable.
+    e.determined = determinedByPoints(shapes[i].model, m.value("not_identifiable", std::vector<std::string>{}));
     evidence.push_back(e);
   }
   const ModelSelection selection = selectNested(evidence, o.selection_alpha);
@@ -369,8 +353,8 @@ QcReport writeSubjectReport(const SubjectReportOptions& o) {
   std::optional<points::MeshFile> bone;
   if (fs::exists(o.folder / "bone.vtp")) bone = points::readMeshFile(o.folder / "bone.vtp");
   const std::optional<CapDepartures> departures =
-      departuresFromModel(o.folder, bone, selected_shape, ct.get(), o.joint, o.side);
-  const QcReport qc = checkSubjectHead(o.folder, o.joint, shapes, ct.get(), departures);
+      departuresFromModel(cloud.positions, bone, selected_shape, ct.get(), o.joint, o.side);
+  const QcReport qc = checkSubjectHead(o.folder, cloud, o.joint, shapes, ct.get(), departures);
   // The head centre, and where the bone departs from the selected model.
   std::vector<Landmark> landmarks = {{"head_center", c}};
   if (departures)

@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "articula/fit/fit_hierarchy.hpp"
+#include "articula/geometry/shape.hpp"
+
 namespace articula::pipeline {
 
 struct Summary {
@@ -84,6 +87,15 @@ struct NestedStep {
   double alpha = NAN;      // the level it was judged at
   bool richer_needed = false;  // p_value < alpha
 };
+/// Whether the points determine a model's shape and place: none of its
+/// parameters among those its fit calls not identifiable but its angles (a
+/// spheroid's spin may be open; its shape is not).
+bool determinedByPoints(geometry::ShapeModel model, const std::vector<std::string>& not_identifiable);
+
+/// The evidence of a fitted hierarchy, every model's points counted as
+/// `n_eff` (NaN: each fit's own residual correlation).
+std::vector<ModelEvidence> modelEvidence(const fit::Summary& fits, double n_eff);
+
 /// The test of `simpler` against `richer` at level `alpha`.
 NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer, double alpha);
 
