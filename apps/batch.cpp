@@ -18,7 +18,7 @@
 #include "articula/core/provenance.hpp"
 #include "articula/pipeline/batch.hpp"
 #include "articula/pipeline/manifest.hpp"
-#include "articula/pipeline/study.hpp"
+#include "articula/study/study.hpp"
 
 namespace articula::apps {
 namespace {
@@ -105,7 +105,7 @@ class BatchCommand : public cli::Command {
     provenance.inputs = {manifest_};
     provenance.seed = common.seed;
     provenance.parameters = {{"jobs", jobs_}};
-    const auto study = pipeline::writeStudyTables(study_dir_, subjects, summary, provenanceJson(provenance));
+    const auto study = study::writeStudyTables(study_dir_, subjects, summary, provenanceJson(provenance));
     log::info("batch: " + std::to_string(summary.succeeded) + " ok (" + std::to_string(summary.resumed) +
               " from an earlier run), " + std::to_string(summary.failed) + " failed, " +
               std::to_string(static_cast<int>(summary.seconds)) + " s");

@@ -7,7 +7,7 @@
 #include "articula/core/log.hpp"
 #include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/pipeline/stages.hpp"
-#include "articula/pipeline/subject_report.hpp"
+#include "articula/subject/subject_report.hpp"
 
 namespace articula::apps {
 namespace {
@@ -40,7 +40,7 @@ class ReportCommand : public cli::Command {
       existing.push_back(options_.folder / file);
     cli::refuseExistingOutputs(existing, common.force);
     options_.seed = common.seed;
-    const pipeline::QcReport qc = pipeline::writeSubjectReport(options_);
+    const checks::QcReport qc = subject::writeSubjectReport(options_);
     for (const std::string& reason : qc.reasons()) log::warn("qc " + reason);
     if (qc.status == "fail") {
       std::string failed;
@@ -53,7 +53,7 @@ class ReportCommand : public cli::Command {
 
  private:
   pipeline::StageSettings settings_;
-  pipeline::SubjectReportOptions& options_ = settings_.report;
+  subject::SubjectReportOptions& options_ = settings_.report;
 };
 
 ARTICULA_REGISTER_COMMAND(ReportCommand)

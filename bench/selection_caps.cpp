@@ -5,7 +5,7 @@
 // Gaussian error field along the normal of 0.05-0.2 mm and correlation
 // length 0-5 mm, caps of half-angle 60-120 degrees about the shape's local
 // z, 1,000 points; each fitted with the hierarchy and selected by
-// pipeline::selectNested at 0.05 with
+// statistics::selectNested at 0.05 with
 //   - the points' n_eff at the selection's length (the report's default, 4 mm),
 //   - each fit's own residual correlation (--selection-length 0).
 // Prints one JSON line per cap (true model, length, noise, the truth's
@@ -33,7 +33,7 @@
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/shape.hpp"
-#include "articula/pipeline/statistics.hpp"
+#include "articula/statistics/model_selection.hpp"
 #include "articula/testsupport/run_all.hpp"
 #include "articula/testsupport/synthetic_cap.hpp"
 
@@ -91,10 +91,10 @@ int main(int argc, char** argv) {
       line["truth_rms_mm"] = std::sqrt(articula::fit::fitFrom(truth, noisy).sse_mm2 / s.points);
       const double n_eff = articula::fit::nEffectiveAtLength(noisy, length_mm);
       line["n_eff"] = n_eff;
-      const articula::pipeline::ModelSelection chosen = articula::pipeline::selectNested(articula::pipeline::modelEvidence(s, n_eff));
+      const articula::statistics::ModelSelection chosen = articula::statistics::selectNested(articula::statistics::modelEvidence(s, n_eff));
       line["at_length"] = chosen.selected;
       line["undetermined"] = chosen.undetermined;
-      line["per_fit"] = articula::pipeline::selectNested(articula::pipeline::modelEvidence(s, NAN)).selected;
+      line["per_fit"] = articula::statistics::selectNested(articula::statistics::modelEvidence(s, NAN)).selected;
     } catch (const std::exception& e) {
       line["error"] = e.what();
     }

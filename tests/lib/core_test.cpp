@@ -17,16 +17,14 @@
 #include "articula/core/csv.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/output_lock.hpp"
+#include "articula/testsupport/scratch_dir.hpp"
 
 namespace articula {
 namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("articula-core-test-" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return articula::testsupport::scratchDir(name);
 }
 
 std::string slurp(const fs::path& p) {

@@ -8,6 +8,7 @@
 
 #include "articula/geometry/surface.hpp"
 #include "articula/phantom/phantom.hpp"
+#include "articula/testsupport/scratch_dir.hpp"
 
 namespace articula::testing {
 
@@ -17,13 +18,8 @@ inline std::filesystem::path sharedData() {
   return ARTICULA_SHARED_DATA_DEFAULT;
 }
 
-/// A fresh scratch folder under the system temp dir.
-inline std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("articula-test-" + name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+/// A fresh scratch folder, removed when the test program ends.
+inline std::filesystem::path scratch(const std::string& name) { return testsupport::scratchDir(name); }
 
 /// Signed distance (mm, > 0 outside) to the head surface, to first order:
 /// F / |grad F|, refined by one Newton step along the gradient.

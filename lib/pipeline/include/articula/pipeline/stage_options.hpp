@@ -19,7 +19,7 @@
 
 #include "articula/imaging/segment.hpp"
 #include "articula/mesh/mesh.hpp"
-#include "articula/pipeline/subject_report.hpp"
+#include "articula/subject/subject_report.hpp"
 #include "articula/sampling/downsample.hpp"
 #include "articula/sampling/select.hpp"
 
@@ -64,7 +64,7 @@ struct StageSettings {
   SampleSettings sample;
   FitSettings fit;
   ErrorsSettings errors;
-  SubjectReportOptions report;
+  subject::SubjectReportOptions report;
 };
 
 /// The field an option sets; its type is the option's.

@@ -1,0 +1,263 @@
+#include "articula/checks/cap_departures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/Geometry>
+
+#include "articula/core/error.hpp"
+#include "articula/distance/signed_distance.hpp"
+#include "articula/geometry/fibonacci.hpp"
+#include "articula/geometry/mesh_components.hpp"
+
+namespace articula::checks {
+namespace {
+
+constexpr double kRimExtensionDeg = 15;   // osteophytes grow at the cap's margin, beyond its points
+constexpr int kCapDirections = 3000;     // about 3.7 degrees apart
+constexpr double kThresholdFloorMm = 0.75;
+constexpr double kFoveaMaxAngleDeg = 45;  // from the medial direction
+constexpr double kFoveaMaxAreaMm2 = 250, kFoveaMaxDepthMm = 5;
+
+double degrees(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const auto k = static_cast<long>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<size_t>(k)];
+}
+
+// "superior, lateral": the LPS axes along which `direction` mostly points,
+// with medial/lateral instead of left/right where the medial side is known.
+std::string anatomicalWords(const Eigen::Vector3d& d, const std::optional<Eigen::Vector3d>& medial) {
+  std::vector<std::pair<double, std::string>> words;
+  const double lr = medial ? d.dot(*medial) : d.x();
+  words.push_back({std::abs(lr), medial ? (lr > 0 ? "medial" : "lateral") : (lr > 0 ? "left" : "right")});
+  words.push_back({std::abs(d.y()), d.y() > 0 ? "posterior" : "anterior"});
+  words.push_back({std::abs(d.z()), d.z() > 0 ? "superior" : "inferior"});
+  std::sort(words.begin(), words.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::string text = words[0].second;
+  for (size_t i = 1; i < words.size(); ++i)
+    if (words[i].first >= 0.4) text += ", " + words[i].second;
+  return text;
+}
+
+// The directions from the head's centre over its articular cap: a lattice
+// of directions, those holding a point's direction, and every hole they
+// enclose (a dome or a fovea the selection left out, gaps between sparse
+// points); beyond it, the largest part without points (the neck's side),
+// whose directions within kRimExtensionDeg of the cap are its rim.
+struct CapDirections {
+  static constexpr char kCap = 0, kRim = 1, kBeyond = 2;
+  Eigen::MatrixX3d directions;
+  std::vector<char> place;
+  int nearest(const Eigen::Vector3d& unit) const {
+    Eigen::Index best = 0;
+    (directions * unit).maxCoeff(&best);
+    return static_cast<int>(best);
+  }
+};
+
+CapDirections capDirections(const Eigen::MatrixX3d& unit_points) {
+  CapDirections cap;
+  const int n = kCapDirections;
+  cap.directions.resize(n, 3);
+  for (int i = 0; i < n; ++i) cap.directions.row(i) = geometry::fibonacciDirection(i, n).transpose();
+  std::vector<char> held(static_cast<size_t>(n), 0);
+  for (Eigen::Index i = 0; i < unit_points.rows(); ++i) held[static_cast<size_t>(cap.nearest(unit_points.row(i).transpose()))] = 1;
+  // Neighbours: within 1.8 lattice spacings (the lattice's spacing is about sqrt(4 pi / n)).
+  const double neighbour_cos = std::cos(1.8 * std::sqrt(4 * M_PI / n));
+  const auto cosine = [&cap](int i, int j) { return cap.directions.row(i).dot(cap.directions.row(j)); };
+  std::vector<Eigen::Vector3i> pairs;  // as degenerate triangles (i, j, j): connectedParts joins through edges
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (cosine(i, j) >= neighbour_cos) pairs.emplace_back(i, j, j);
+  Eigen::MatrixX3i edges(static_cast<Eigen::Index>(pairs.size()), 3);
+  for (size_t k = 0; k < pairs.size(); ++k) edges.row(static_cast<Eigen::Index>(k)) = pairs[k].transpose();
+  std::vector<char> empty(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) empty[static_cast<size_t>(i)] = !held[static_cast<size_t>(i)];
+  const std::vector<int> part = geometry::connectedParts(empty, edges);
+  std::vector<int> size(static_cast<size_t>(n), 0);
+  for (int p : part)
+    if (p >= 0) ++size[static_cast<size_t>(p)];
+  const int beyond = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  cap.place.assign(static_cast<size_t>(n), CapDirections::kCap);
+  const double rim_cos = std::cos(kRimExtensionDeg * M_PI / 180);
+  for (int i = 0; i < n; ++i) {
+    if (part[static_cast<size_t>(i)] != beyond || size[static_cast<size_t>(beyond)] == 0) continue;
+    bool near_cap = false;
+    for (int j = 0; j < n && !near_cap; ++j)
+      near_cap = part[static_cast<size_t>(j)] != beyond && cosine(i, j) >= rim_cos;
+    cap.place[static_cast<size_t>(i)] = near_cap ? CapDirections::kRim : CapDirections::kBeyond;
+  }
+  return cap;
+}
+
+// Each vertex's share of its triangles' area (a third of each), and its
+// area-weighted normal (winding as stored).
+void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F, Eigen::VectorXd& area, Eigen::MatrixX3d& normal) {
+  area = Eigen::VectorXd::Zero(V.rows());
+  normal = Eigen::MatrixX3d::Zero(V.rows(), 3);
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    const Eigen::Vector3d a = V.row(F(t, 0)), b = V.row(F(t, 1)), c = V.row(F(t, 2));
+    const Eigen::Vector3d twice = (b - a).cross(c - a);
+    for (int k = 0; k < 3; ++k) {
+      area[F(t, k)] += twice.norm() / 6;
+      normal.row(F(t, k)) += twice.transpose();
+    }
+  }
+}
+
+}  // namespace
+
+double CapDepartures::largestFindingMm2() const {
+  double largest = 0;
+  for (const auto& r : regions)
+    if (r.kind != "fovea" && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
+  return largest;
+}
+
+nlohmann::json CapDepartures::toJson() const {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& r : regions)
+    list.push_back({{"kind", r.kind},
+                    {"area_mm2", r.area_mm2},
+                    {"depth_mm", r.depth_mm},
+                    {"centre_mm", {r.centre[0], r.centre[1], r.centre[2]}},
+                    {"direction", {r.direction[0], r.direction[1], r.direction[2]}},
+                    {"from_cap_axis_deg", r.from_cap_axis_deg},
+                    {"where", r.where}});
+  return {{"cap_axis", {cap_axis[0], cap_axis[1], cap_axis[2]}},
+          {"cap_half_angle_deg", cap_half_angle_deg},
+          {"rim_extension_deg", rim_extension_deg},
+          {"threshold_mm", threshold_mm},
+          {"cap_area_mm2", cap_area_mm2},
+          {"min_region_mm2", kMinDepartingRegionMm2},
+          {"regions", list}};
+}
+
+CapDepartures capDepartures(const CapDepartureInput& in) {
+  if (in.points.rows() < 4) throw InputError("cap departures need at least 4 articular points");
+  if (in.triangles.rows() == 0) throw InputError("cap departures need the bone's mesh with its triangles");
+  CapDepartures out;
+  const Eigen::Vector3d c = in.model.center;
+  Eigen::MatrixX3d u = in.points.rowwise() - c.transpose();
+  u.rowwise().normalize();
+  out.cap_axis = u.colwise().mean().transpose().normalized();
+  std::vector<double> angles(static_cast<size_t>(u.rows()));
+  for (Eigen::Index i = 0; i < u.rows(); ++i) angles[static_cast<size_t>(i)] = degrees(u.row(i).transpose(), out.cap_axis);
+  out.cap_half_angle_deg = percentile(angles, 0.98);
+  out.rim_extension_deg = kRimExtensionDeg;
+  const CapDirections cap = capDirections(u);
+
+  // The points' own scatter about the model: a departure must exceed it.
+  const Eigen::VectorXd residual = distance::signedDistances(in.model, in.points);
+  std::vector<double> r(residual.data(), residual.data() + residual.size());
+  const double median = percentile(r, 0.5);
+  for (double& v : r) v = std::abs(v - median);
+  const double robust_sd = 1.4826 * percentile(r, 0.5);
+  out.threshold_mm = std::max({kThresholdFloorMm, 3 * robust_sd, 0.3 * in.voxel_mm});
+
+  // The vertices over the cap and its rim, near the head's surface, facing
+  // outwards (a cavity's walls inside the label face other ways).
+  const Eigen::MatrixX3d& V = in.vertices;
+  Eigen::VectorXd area;
+  Eigen::MatrixX3d normal;
+  vertexAreasAndNormals(V, in.triangles, area, normal);
+  const double radius = in.model.radii.maxCoeff();
+  std::vector<int> zone;
+  std::vector<char> zone_place;
+  Eigen::Index facing_out = 0, facing_in = 0;
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d d = V.row(v).transpose() - c;
+    const double reach = d.norm();
+    if (reach < 0.5 * radius || reach > 1.5 * radius) continue;
+    const double facing = normal.row(v).dot(d);
+    facing_out += facing > 0;
+    facing_in += facing < 0;
+    zone.push_back(static_cast<int>(v));
+    zone_place.push_back(cap.place[static_cast<size_t>(cap.nearest(d / reach))]);
+  }
+  const double outward_sign = facing_out >= facing_in ? 1.0 : -1.0;  // the mesh's winding, whichever it is
+  Eigen::MatrixX3d zone_points(static_cast<Eigen::Index>(zone.size()), 3);
+  for (size_t i = 0; i < zone.size(); ++i) zone_points.row(static_cast<Eigen::Index>(i)) = V.row(zone[i]);
+  const Eigen::VectorXd distance = distance::signedDistances(in.model, zone_points);
+
+  std::vector<char> inward(static_cast<size_t>(V.rows()), 0), outward(static_cast<size_t>(V.rows()), 0),
+      beyond_rim(static_cast<size_t>(V.rows()), 0);
+  std::vector<double> vertex_distance(static_cast<size_t>(V.rows()), 0);
+  for (size_t i = 0; i < zone.size(); ++i) {
+    const int v = zone[i];
+    if (outward_sign * normal.row(v).dot(V.row(v) - c.transpose()) <= 0) continue;
+    const bool on_cap = zone_place[i] == CapDirections::kCap;
+    if (on_cap) out.cap_area_mm2 += area[v];
+    const double distance_mm = distance[static_cast<Eigen::Index>(i)];
+    vertex_distance[static_cast<size_t>(v)] = distance_mm;
+    beyond_rim[static_cast<size_t>(v)] = zone_place[i] == CapDirections::kBeyond;
+    // Inwards only over the cap: beyond it the neck curves in by nature.
+    if (on_cap && distance_mm < -out.threshold_mm) inward[static_cast<size_t>(v)] = 1;
+    if (distance_mm > out.threshold_mm) outward[static_cast<size_t>(v)] = 1;
+  }
+
+  std::vector<int> region_of_vertex(static_cast<size_t>(V.rows()), -1);
+  for (const bool is_inward : {true, false}) {
+    const std::vector<int> part = geometry::connectedParts(is_inward ? inward : outward, in.triangles);
+    std::vector<DepartingRegion> regions;
+    std::vector<char> reaches_beyond;
+    for (size_t v = 0; v < part.size(); ++v) {
+      if (part[v] < 0) continue;
+      if (static_cast<size_t>(part[v]) >= regions.size()) {
+        regions.resize(static_cast<size_t>(part[v]) + 1);
+        reaches_beyond.resize(regions.size(), 0);
+      }
+      reaches_beyond[static_cast<size_t>(part[v])] |= beyond_rim[v];
+      DepartingRegion& region = regions[static_cast<size_t>(part[v])];
+      const double a = area[static_cast<Eigen::Index>(v)];
+      region.area_mm2 += a;
+      region.centre += a * V.row(static_cast<Eigen::Index>(v)).transpose();
+      region.depth_mm = std::max(region.depth_mm, std::abs(vertex_distance[v]));
+    }
+    std::vector<int> kept_as(regions.size(), -1);
+    for (size_t k = 0; k < regions.size(); ++k) {
+      DepartingRegion& region = regions[k];
+      // Outwards, a region that runs on beyond the rim is the neck rising
+      // out of the head's surface (or a bone beyond it), not a lip on the rim.
+      if (region.area_mm2 < kMinDepartingRegionMm2 || reaches_beyond[k]) continue;
+      region.centre /= region.area_mm2;
+      region.direction = (region.centre - c).normalized();
+      region.from_cap_axis_deg = degrees(region.direction, out.cap_axis);
+      region.where = anatomicalWords(region.direction, in.medial);
+      region.kind = is_inward ? "inward" : "outward";
+      // A hip's fovea capitis: a small pit at the head's medial pole, where
+      // the ligament of the head attaches; every femoral head has one.
+      if (is_inward && in.medial && degrees(region.direction, *in.medial) <= kFoveaMaxAngleDeg &&
+          region.area_mm2 <= kFoveaMaxAreaMm2 && region.depth_mm <= kFoveaMaxDepthMm)
+        region.kind = "fovea";
+      kept_as[k] = static_cast<int>(out.regions.size());
+      out.regions.push_back(region);
+    }
+    for (size_t v = 0; v < part.size(); ++v)
+      if (part[v] >= 0 && kept_as[static_cast<size_t>(part[v])] >= 0) region_of_vertex[v] = kept_as[static_cast<size_t>(part[v])];
+  }
+  // Largest first, the vertices' region indices following.
+  std::vector<int> order(out.regions.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&out](int a, int b) { return out.regions[static_cast<size_t>(a)].area_mm2 > out.regions[static_cast<size_t>(b)].area_mm2; });
+  std::vector<int> rank(order.size());
+  std::vector<DepartingRegion> sorted;
+  for (size_t k = 0; k < order.size(); ++k) {
+    rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+    sorted.push_back(out.regions[static_cast<size_t>(order[k])]);
+  }
+  out.regions = std::move(sorted);
+  for (int& r : region_of_vertex)
+    if (r >= 0) r = rank[static_cast<size_t>(r)];
+  out.region_of_vertex = std::move(region_of_vertex);
+  return out;
+}
+
+}  // namespace articula::checks

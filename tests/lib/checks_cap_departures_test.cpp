@@ -1,0 +1,146 @@
+// Departures of a bone's mesh from its fitted head, on an exact sphere mesh
+// reshaped where the answer is known in closed form: a dome flattened by a
+// plane, an outward bump on the cap's rim, a pit at the medial pole.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "articula/geometry/surface.hpp"
+#include "articula/checks/cap_departures.hpp"
+
+namespace articula::checks {
+namespace {
+
+constexpr double kRadius = 20;
+
+geometry::ShapeParameters sphere() {
+  geometry::ShapeParameters s;
+  s.model = geometry::ShapeModel::Sphere;
+  s.radii = Eigen::Vector3d::Constant(kRadius);
+  s.center = Eigen::Vector3d(10, -30, 5);
+  return s;
+}
+
+// The sphere's exact mesh (about 0.4 mm edges) and, as articular points,
+// its vertices more than 60 degrees above the south pole (the neck's side)
+// and away from `skip` (the dome the selection would leave out).
+struct Case {
+  CapDepartureInput input;
+  Case() {
+    const geometry::SurfaceMesh mesh = geometry::makeSurface(sphere())->sample(320, 160);
+    input.vertices = mesh.vertices;
+    input.triangles = mesh.triangles;
+    input.model = sphere();
+    input.medial = Eigen::Vector3d::UnitX();
+  }
+  Eigen::Vector3d local(Eigen::Index v) const { return input.vertices.row(v).transpose() - sphere().center; }
+  void choosePoints(double skip_above_z) {
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index v = 0; v < input.vertices.rows(); ++v)
+      if (local(v).z() > -0.5 * kRadius && local(v).z() < skip_above_z) rows.push_back(v);
+    input.points.resize(static_cast<Eigen::Index>(rows.size()), 3);
+    for (size_t i = 0; i < rows.size(); ++i) input.points.row(static_cast<Eigen::Index>(i)) = input.vertices.row(rows[i]);
+  }
+  // Moves vertices within `reach` mm of the surface point along `direction`
+  // radially by height * (1 - (s / reach)^2): a smooth bump (or pit, height < 0).
+  void bump(const Eigen::Vector3d& direction, double reach, double height) {
+    const Eigen::Vector3d apex = kRadius * direction.normalized();
+    for (Eigen::Index v = 0; v < input.vertices.rows(); ++v) {
+      const double s = (local(v) - apex).norm();
+      if (s < reach)
+        input.vertices.row(v) += (height * (1 - (s / reach) * (s / reach)) * local(v).normalized()).transpose();
+    }
+  }
+};
+
+TEST(CapDepartures, AnExactSphereDepartsNowhere) {
+  Case c;
+  c.choosePoints(kRadius);
+  const CapDepartures d = capDepartures(c.input);
+  EXPECT_TRUE(d.regions.empty());
+  EXPECT_NEAR(d.threshold_mm, 0.75, 1e-9);
+  // The cap: from the pole to 120 degrees (the 98th percentile of the points' angles, 118).
+  EXPECT_NEAR(d.cap_axis.z(), 1, 1e-3);
+  EXPECT_NEAR(d.cap_half_angle_deg, 118, 2);
+  const double cap_area = 2 * M_PI * kRadius * kRadius * (1 - std::cos(120 * M_PI / 180));
+  EXPECT_NEAR(d.cap_area_mm2, cap_area, 0.03 * cap_area);
+}
+
+TEST(CapDepartures, AFlattenedDomeIsMeasuredInAreaAndDepth) {
+  Case c;
+  const double h = 0.12 * kRadius, plane = kRadius - h;  // cut 2.4 mm below the top
+  for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v)
+    if (c.local(v).z() > plane) c.input.vertices(v, 2) = sphere().center.z() + plane;
+  c.choosePoints(plane - 0.5);
+  const CapDepartures d = capDepartures(c.input);
+  ASSERT_EQ(d.regions.size(), 1u);
+  const DepartingRegion& dome = d.regions[0];
+  EXPECT_EQ(dome.kind, "inward");
+  EXPECT_NEAR(dome.depth_mm, h, 0.05);
+  // The flat's part more than t below the sphere: a disc of radius^2 = (R - t)^2 - (R - h)^2.
+  const double t = d.threshold_mm, expected = M_PI * ((kRadius - t) * (kRadius - t) - plane * plane);
+  EXPECT_NEAR(dome.area_mm2, expected, 0.08 * expected);
+  EXPECT_GT(dome.direction.z(), 0.99);
+  EXPECT_EQ(dome.where, "superior");
+  EXPECT_NEAR(d.largestFindingMm2(), dome.area_mm2, 1e-9);  // 2.4 mm deep: a finding
+  // Every vertex of the region, and only those, is marked with it: on the plane, deeper than t.
+  ASSERT_EQ(d.region_of_vertex.size(), static_cast<size_t>(c.input.vertices.rows()));
+  for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v) {
+    const bool deep = std::abs(c.local(v).z() - plane) < 1e-9 && c.local(v).norm() < kRadius - t - 1e-6;
+    const bool edge = std::abs(c.local(v).norm() - (kRadius - t)) < 0.05;  // rounding at the border
+    if (!edge) EXPECT_EQ(d.region_of_vertex[static_cast<size_t>(v)], deep ? 0 : -1) << v;
+  }
+}
+
+TEST(CapDepartures, AnOsteophyteOnTheRimIsOutwardAndAPitAtTheMedialPoleIsTheFovea) {
+  Case c;
+  c.choosePoints(kRadius);
+  // The rim lies about 118 degrees from the pole; a 3 mm lip at 125 degrees, lateral.
+  const double rim = 125 * M_PI / 180;
+  c.bump(Eigen::Vector3d(-std::sin(rim), 0, std::cos(rim)), 4, 3);
+  c.bump(Eigen::Vector3d::UnitX(), 5, -2);  // the fovea: 5 mm across, 2 mm deep, medial
+  const CapDepartures d = capDepartures(c.input);
+  ASSERT_EQ(d.regions.size(), 2u);
+  const DepartingRegion* lip = nullptr;
+  const DepartingRegion* fovea = nullptr;
+  for (const auto& r : d.regions) (r.kind == "outward" ? lip : fovea) = &r;
+  ASSERT_TRUE(lip && fovea);
+  EXPECT_NEAR(lip->depth_mm, 3, 0.05);
+  // The lip rises above t within s = 4 sqrt(1 - t/3) of its apex: the area
+  // of a paraboloid of slope k rho (k = 2 x 3 / 4^2) to s on a plane; on
+  // the sphere, pushed out radially by 0.75-3 mm, it stretches by
+  // ((R + height) / R)^2: 1.08-1.32.
+  const double k = 2.0 * 3 / 16, s = 4 * std::sqrt(1 - d.threshold_mm / 3);
+  const double flat = 2 * M_PI / (3 * k * k) * (std::pow(1 + k * k * s * s, 1.5) - 1);
+  EXPECT_GT(lip->area_mm2, 1.08 * flat);
+  EXPECT_LT(lip->area_mm2, 1.32 * flat);
+  EXPECT_EQ(lip->where, "lateral, inferior");
+  EXPECT_EQ(fovea->kind, "fovea");
+  EXPECT_NEAR(fovea->depth_mm, 2, 0.05);
+  EXPECT_NEAR(d.largestFindingMm2(), lip->area_mm2, 1e-9);  // the fovea is anatomy, not a finding
+
+  // Without the hip's medial side, the same pit is an inward departure,
+  // listed, but at 2 mm deep no finding.
+  c.input.medial.reset();
+  const CapDepartures unsided = capDepartures(c.input);
+  ASSERT_EQ(unsided.regions.size(), 2u);
+  for (const auto& r : unsided.regions) EXPECT_NE(r.kind, "fovea");
+  c.bump(Eigen::Vector3d::UnitX(), 5, 0.1);  // 1.9 mm deep
+  EXPECT_NEAR(capDepartures(c.input).largestFindingMm2(), lip->area_mm2, 1.0);
+}
+
+TEST(CapDepartures, ANeckRisingOutOfTheHeadBeyondTheRimIsNoFinding) {
+  Case c;
+  c.choosePoints(kRadius);
+  // Beyond the cap (past 120 degrees) the surface leaves the sphere outwards
+  // and keeps rising to the zone's edge, as a neck wider than the head's
+  // waist does: 0 at 125 degrees, 1 mm more every 5 degrees.
+  for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v) {
+    const double angle = std::acos(c.local(v).normalized().z()) * 180 / M_PI;
+    if (angle > 125) c.input.vertices.row(v) += ((angle - 125) / 5 * c.local(v).normalized()).transpose();
+  }
+  EXPECT_TRUE(capDepartures(c.input).regions.empty());
+}
+
+}  // namespace
+}  // namespace articula::checks
