@@ -7,7 +7,7 @@
 # head unflattened departs nowhere by the finding depth, and the check passes.
 # At 0.8 mm voxels, on the default edges (the blurred-cortex model): across
 # 1.5 mm slices the model's departure comes out 0.26 mm shallow and its area
-# a fifth short (docs/benchmarks.md, surface bias at coarser voxels).
+# a fifth short (docs/benchmarks.md, "Surface bias by voxel size").
 # labels: full-size
 source "$(dirname "$0")/common.bash"
 for shape in flat plain; do
