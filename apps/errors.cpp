@@ -86,7 +86,7 @@ class ErrorsCommand : public cli::Command {
   }
 
   int run(const cli::CommonOptions& common) override {
-    const pipeline::ErrorsSettings& given = settings_.errors;
+    const pipeline::ErrorsSettings& given = settings_.errors();
     const points::PointCloud cloud = points::readPoints(input_);
     points::checkFittable(cloud, 1, input_.string());
     const nlohmann::json doc = readJsonFile(fits_, "--fits");

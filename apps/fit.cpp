@@ -90,7 +90,7 @@ class FitCommand : public cli::Command {
   }
 
   int run(const cli::CommonOptions& common) override {
-    const pipeline::FitSettings& given = settings_.fit;
+    const pipeline::FitSettings& given = settings_.fit();
     fit::Options o;
     o.models.clear();
     for (const auto& m : given.models) o.models.push_back(geometry::modelFromName(m));

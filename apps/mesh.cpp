@@ -29,7 +29,7 @@ class MeshCommand : public cli::Command {
     pipeline::addStageOptions(app, name(), settings_);
   }
   int run(const cli::CommonOptions& common) override {
-    const pipeline::MeshSettings& given = settings_.mesh;
+    const pipeline::MeshSettings& given = settings_.mesh();
     mesh::MeshOptions options = given.surface;
     mesh::EdgeSnapOptions snap = given.edges;
     imaging::limitImagingThreads(common.threadCount());

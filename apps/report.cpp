@@ -53,7 +53,7 @@ class ReportCommand : public cli::Command {
 
  private:
   pipeline::StageSettings settings_;
-  subject::SubjectReportOptions& options_ = settings_.report;
+  subject::SubjectReportOptions& options_ = settings_.report();
 };
 
 ARTICULA_REGISTER_COMMAND(ReportCommand)

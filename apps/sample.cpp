@@ -34,7 +34,7 @@ class SampleCommand : public cli::Command {
     app.add_option("--format", format_, "ply or csv (default: from the extension)")->check(CLI::IsMember({"ply", "csv"}));
   }
   int run(const cli::CommonOptions& common) override {
-    const pipeline::SampleSettings& given = settings_.sample;
+    const pipeline::SampleSettings& given = settings_.sample();
     sampling::SelectOptions select_options = given.selection;
     sampling::DownsampleOptions down = given.downsampling;
     sampling::parseSelection(given.select, select_options);

@@ -35,7 +35,7 @@ class SegmentCommand : public cli::Command {
     pipeline::addStageOptions(app, name(), settings_);
   }
   int run(const cli::CommonOptions& common) override {
-    const pipeline::SegmentSettings& given = settings_.segment;
+    const pipeline::SegmentSettings& given = settings_.segment();
     imaging::SegmentOptions options = given.head;
     imaging::limitImagingThreads(common.threadCount());
     options.joint = joint_ == "hip" ? imaging::Joint::Hip : imaging::Joint::Shoulder;

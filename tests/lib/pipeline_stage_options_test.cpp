@@ -23,15 +23,15 @@ std::vector<std::string> valuesOf(const p::StageOption& option, const std::strin
 
 // The library's own checks of a stage's options structs (the command-line
 // only stages, errors and report, have none).
-void validateInLibrary(const std::string& stage, const p::StageSettings& s) {
-  if (stage == "segment") s.segment.head.validate();
+void validateInLibrary(const std::string& stage, p::StageSettings s) {
+  if (stage == "segment") s.segment().head.validate();
   if (stage == "mesh") {
-    s.mesh.surface.validate();
-    s.mesh.edges.validate();
+    s.mesh().surface.validate();
+    s.mesh().edges.validate();
   }
   if (stage == "sample") {
-    s.sample.selection.validate();
-    s.sample.downsampling.validate();
+    s.sample().selection.validate();
+    s.sample().downsampling.validate();
   }
 }
 
@@ -141,10 +141,10 @@ TEST(StageOptions, StageCommandLineSetsTheFieldsAndRefusesOutOfRange) {
   CLI::App app;
   p::addStageOptions(app, "segment", settings);
   parse(app, {"--hu-min", "150", "--seed-point", "1,2,3", "--label-value", "4"});
-  EXPECT_EQ(settings.segment.head.hu_min, 150.0);
-  EXPECT_EQ(settings.segment.seed_point, (std::vector<double>{1, 2, 3}));
-  EXPECT_EQ(settings.segment.label_value, 4);
-  EXPECT_EQ(settings.segment.head.hu_max, 3000.0);  // not given: the library's default
+  EXPECT_EQ(settings.segment().head.hu_min, 150.0);
+  EXPECT_EQ(settings.segment().seed_point, (std::vector<double>{1, 2, 3}));
+  EXPECT_EQ(settings.segment().label_value, 4);
+  EXPECT_EQ(settings.segment().head.hu_max, 3000.0);  // not given: the library's default
 
   p::StageSettings other;
   CLI::App refusing;

@@ -27,7 +27,7 @@ FitSettings::FitSettings() {
 
 namespace {
 
-// The settings field an option binds: `FIELD(segment.head.hu_min)`.
+// The settings field an option binds: `FIELD(segment().head.hu_min)`.
 #define FIELD(path) [](StageSettings& s) -> OptionField { return &s.path; }
 
 StageOption option(std::string name, OptionField (*field)(StageSettings&), std::string help) {
@@ -51,75 +51,75 @@ const std::map<std::string, std::vector<StageOption>>& declarations() {
   static const std::map<std::string, std::vector<StageOption>> table = {
       {"segment",
        {
-           option("seed-point", FIELD(segment.seed_point), "A point inside the head, X,Y,Z in LPS mm (skips the search)")
+           option("seed-point", FIELD(segment().seed_point), "A point inside the head, X,Y,Z in LPS mm (skips the search)")
                .values(3)
                .unitIs("mm"),
-           option("series-uid", FIELD(segment.series_uid),
+           option("series-uid", FIELD(segment().series_uid),
                   "DICOM series to read when the folder holds several (empty: the series whose Series Instance UID "
                   "is empty)"),
-           option("hu-min", FIELD(segment.head.hu_min), "Lower end of the bone window").in(-2000, 10000).unitIs("HU"),
-           option("hu-max", FIELD(segment.head.hu_max), "Upper end of the bone window").in(-2000, 40000).unitIs("HU"),
-           option("surface-hu", FIELD(segment.head.surface_hu), "Level of the head's final surface")
+           option("hu-min", FIELD(segment().head.hu_min), "Lower end of the bone window").in(-2000, 10000).unitIs("HU"),
+           option("hu-max", FIELD(segment().head.hu_max), "Upper end of the bone window").in(-2000, 40000).unitIs("HU"),
+           option("surface-hu", FIELD(segment().head.surface_hu), "Level of the head's final surface")
                .in(-2000, 40000)
                .unitIs("HU"),
-           option("level-set", FIELD(segment.head.level_set_iterations),
+           option("level-set", FIELD(segment().head.level_set_iterations),
                   "Refine the head's surface by a geodesic active contour of this many iterations (0: off)")
                .in(0, 10000),
-           option("close-radius", FIELD(segment.head.close_radius_mm),
+           option("close-radius", FIELD(segment().head.close_radius_mm),
                   "Closing radius before hole filling (bridges speckled cancellous bone; 0: off)")
                .in(0, 20)
                .unitIs("mm"),
-           option("midline-margin", FIELD(segment.head.midline_margin_mm),
+           option("midline-margin", FIELD(segment().head.midline_margin_mm),
                   "Least distance of an automatically found head from the volume's mid-sagittal plane "
                   "(-1: 40 mm when the field of view spans 250 mm or more left-right, else 0)")
                .in(-1, 500)
                .unitIs("mm"),
-           option("min-coverage", FIELD(segment.head.min_coverage),
+           option("min-coverage", FIELD(segment().head.min_coverage),
                   "Least share of an automatically found head's sphere that is bone surface")
                .in(0, 1),
-           option("roi", FIELD(segment.roi), "Box xmin,ymin,zmin,xmax,ymax,zmax in LPS mm").values(6).unitIs("mm"),
-           option("min-radius", FIELD(segment.head.min_head_radius_mm), "Smallest plausible head radius")
+           option("roi", FIELD(segment().roi), "Box xmin,ymin,zmin,xmax,ymax,zmax in LPS mm").values(6).unitIs("mm"),
+           option("min-radius", FIELD(segment().head.min_head_radius_mm), "Smallest plausible head radius")
                .in(1, 60)
                .unitIs("mm"),
-           option("max-radius", FIELD(segment.head.max_head_radius_mm), "Largest plausible head radius")
+           option("max-radius", FIELD(segment().head.max_head_radius_mm), "Largest plausible head radius")
                .in(1, 60)
                .unitIs("mm"),
-           option("label", FIELD(segment.label),
+           option("label", FIELD(segment().label),
                   "A label map in the CT's grid (a femur or humerus mask from another tool): the head is cut from "
                   "its bone"),
-           option("label-value", FIELD(segment.label_value),
+           option("label-value", FIELD(segment().label_value),
                   "The label's value of the bone (0: every non-zero voxel)")
                .in(0, 65535),
        }},
       {"mesh",
        {
-           option("smoothing", FIELD(mesh.smoothing), "laplacian, sinc (windowed sinc) or none")
+           option("smoothing", FIELD(mesh().smoothing), "laplacian, sinc (windowed sinc) or none")
                .oneOf({"laplacian", "sinc", "none"}),
-           option("smooth-iterations", FIELD(mesh.surface.smooth_iterations), "Smoothing iterations").in(0, 10000),
-           option("relaxation", FIELD(mesh.surface.relaxation), "Laplacian relaxation factor").above(0).in(0, 1),
-           option("passband", FIELD(mesh.surface.passband), "Windowed sinc pass band").above(0).in(0, 2),
-           option("decimate", FIELD(mesh.surface.decimate), "Fraction of triangles to remove (0 = none; below 1)")
+           option("smooth-iterations", FIELD(mesh().surface.smooth_iterations), "Smoothing iterations").in(0, 10000),
+           option("relaxation", FIELD(mesh().surface.relaxation), "Laplacian relaxation factor").above(0).in(0, 1),
+           option("passband", FIELD(mesh().surface.passband), "Windowed sinc pass band").above(0).in(0, 2),
+           option("decimate", FIELD(mesh().surface.decimate), "Fraction of triangles to remove (0 = none; below 1)")
                .in(0, 1),
-           option("all-components", FIELD(mesh.all_components), "Keep every connected surface, not only the largest"),
-           option("series-uid", FIELD(mesh.series_uid),
+           option("all-components", FIELD(mesh().all_components), "Keep every connected surface, not only the largest"),
+           option("series-uid", FIELD(mesh().series_uid),
                   "With --ct: the DICOM series to read when the folder holds several (empty: the series whose UID is "
                   "empty)"),
-           option("edge-search", FIELD(mesh.edges.search_mm),
+           option("edge-search", FIELD(mesh().edges.search_mm),
                   "With --ct: edge search either side of a vertex (0: 1.5 voxels, at least 1.5 mm)")
                .in(0, 10)
                .unitIs("mm"),
-           option("edge-model", FIELD(mesh.edge_model),
+           option("edge-model", FIELD(mesh().edge_model),
                   "With --ct: 'steepest' puts each edge on the steepest HU fall (a cortex thinner than about three "
                   "point-spreads pulls it outwards); 'cortex' on the outer surface of a blurred-cortex model fitted to "
                   "the voxels about the normal, with one point-spread for the CT; 'auto' the cortex model on CTs "
                   "whose voxels are at most 1.5 mm within the slices and 3 mm across them, the steepest fall beyond")
                .oneOf({"auto", "cortex", "steepest"}),
-           option("point-spread", FIELD(mesh.edges.point_spread_mm),
+           option("point-spread", FIELD(mesh().edges.point_spread_mm),
                   "With --ct and the cortex model: the scanner's Gaussian point-spread (standard deviation) within "
                   "the slices (0: this and the slices' estimated from the CT's edges)")
                .in(0, 3)
                .unitIs("mm"),
-           option("slice-point-spread", FIELD(mesh.edges.slice_point_spread_mm),
+           option("slice-point-spread", FIELD(mesh().edges.slice_point_spread_mm),
                   "With --point-spread: the point-spread across the slices (the slice profile's standard deviation; "
                   "0: as within the slices)")
                .in(0, 3)
@@ -127,63 +127,63 @@ const std::map<std::string, std::vector<StageOption>>& declarations() {
        }},
       {"sample",
        {
-           option("select", FIELD(sample.select),
+           option("select", FIELD(sample().select),
                   "auto | sphere:X,Y,Z,R | box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (LPS mm)"),
-           option("ball-radius", FIELD(sample.downsampling.ball_radius_mm), "Open-ball radius of the down-sampling")
+           option("ball-radius", FIELD(sample().downsampling.ball_radius_mm), "Open-ball radius of the down-sampling")
                .in(0, 1000)
                .unitIs("mm"),
-           option("ratio", FIELD(sample.downsampling.ratio),
+           option("ratio", FIELD(sample().downsampling.ratio),
                   "Stop when kept/original reaches this fraction (1: until no point is left)")
                .above(0)
                .in(0, 1),
            // Ranges as the library checks them, one against the other (0 < min < max <= 200 mm).
-           option("min-radius", FIELD(sample.selection.min_radius_mm), "auto: smallest head radius").unitIs("mm"),
-           option("max-radius", FIELD(sample.selection.max_radius_mm), "auto: largest head radius").unitIs("mm"),
-           option("band", FIELD(sample.selection.band_mm), "auto: distance band around the sphere")
+           option("min-radius", FIELD(sample().selection.min_radius_mm), "auto: smallest head radius").unitIs("mm"),
+           option("max-radius", FIELD(sample().selection.max_radius_mm), "auto: largest head radius").unitIs("mm"),
+           option("band", FIELD(sample().selection.band_mm), "auto: distance band around the sphere")
                .above(0)
                .in(0, 50)
                .unitIs("mm"),
-           option("min-points", FIELD(sample.selection.min_points), "Fewest selected points accepted")
+           option("min-points", FIELD(sample().selection.min_points), "Fewest selected points accepted")
                .in(1, 100000000),
        }},
       {"fit",
        {
-           option("models", FIELD(fit.models), "Comma-separated models to report").oneOf(modelNames()),
-           option("objective", FIELD(fit.objective), "geometric (orthogonal distances) or algebraic (thesis eq. 3.1)")
+           option("models", FIELD(fit().models), "Comma-separated models to report").oneOf(modelNames()),
+           option("objective", FIELD(fit().objective), "geometric (orthogonal distances) or algebraic (thesis eq. 3.1)")
                .oneOf({"geometric", "algebraic"}),
-           option("strategy", FIELD(fit.strategy),
+           option("strategy", FIELD(fit().strategy),
                   "local (from the hierarchical start) or global-local (GN_CRS2_LM first)")
                .oneOf({"local", "global-local"}),
-           option("local-algorithm", FIELD(fit.local_algorithm),
+           option("local-algorithm", FIELD(fit().local_algorithm),
                   "Local method: LM (Levenberg-Marquardt on the residuals) or NLopt's LD_SLSQP, LN_BOBYQA, LD_LBFGS, "
                   "LD_MMA"),
-           option("max-evaluations", FIELD(fit.max_evaluations), "Evaluation cap per local run").in(1, 100000000),
-           option("sample-points", FIELD(fit.sample_points),
+           option("max-evaluations", FIELD(fit().max_evaluations), "Evaluation cap per local run").in(1, 100000000),
+           option("sample-points", FIELD(fit().sample_points),
                   "More points than this: fit on a seeded random sample of this many, then finish on all (0 = always "
                   "all; else at least 1000)")
                .in(0, 100000000),
-           option("bounds", FIELD(fit.bounds), "JSON of parameter bounds overrides, e.g. {\"gamma1\": [2, 3]}"),
+           option("bounds", FIELD(fit().bounds), "JSON of parameter bounds overrides, e.g. {\"gamma1\": [2, 3]}"),
        }},
       {"errors",
        {
-           option("band", FIELD(errors.band_mm), "Half-width of the green band of the coloured points")
+           option("band", FIELD(errors().band_mm), "Half-width of the green band of the coloured points")
                .above(0)
                .in(0, 1000)
                .unitIs("mm")
                .runAs("errors-band"),
-           option("resolution", FIELD(errors.resolution), "Surface mesh steps around the local z axis").in(8, 2048),
-           option("map-points", FIELD(errors.map_points),
+           option("resolution", FIELD(errors().resolution), "Surface mesh steps around the local z axis").in(8, 2048),
+           option("map-points", FIELD(errors().map_points),
                   "Points drawn per model in error_map.svg (every k-th when more)")
                .in(1, 100000000),
        }},
       {"report",
        {
-           option("series-uid", FIELD(report.series_uid),
+           option("series-uid", FIELD(report().series_uid),
                   "Series Instance UID of the CT in a DICOM folder holding several (for the slices of report.html)"),
-           option("selection-alpha", FIELD(report.selection_alpha),
+           option("selection-alpha", FIELD(report().selection_alpha),
                   "Level of the nested tests that take a richer model (0: always the sphere)")
                .in(0, 0.5),
-           option("selection-length", FIELD(report.selection_length_mm),
+           option("selection-length", FIELD(report().selection_length_mm),
                   "Length over which the nested tests count the surface's errors as shared (0: each fit's own "
                   "residual correlation)")
                .in(0, 50)

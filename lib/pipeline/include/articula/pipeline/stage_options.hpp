@@ -9,7 +9,9 @@
 // The arguments that wire a stage into a subject's folder (-i, -o, --ct,
 // --fits, --joint, --side, the sample's --format) are the stage table's
 // (stages.hpp), not options a user gives through run.
+#include <any>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <variant>
@@ -58,13 +60,26 @@ struct ErrorsSettings {
   int resolution = 96;   // fitted surfaces' steps about their z axis
   int map_points = 2000; // points per model in error_map.svg
 };
-struct StageSettings {
-  SegmentSettings segment;
-  MeshSettings mesh;
-  SampleSettings sample;
-  FitSettings fit;
-  ErrorsSettings errors;
-  subject::SubjectReportOptions report;
+/// Every stage's settings, by stage name: each stage's own struct, made with
+/// its defaults when first asked for, so that a stage registered from its
+/// own file (stages.hpp) brings its settings along.
+class StageSettings {
+ public:
+  template <class Settings>
+  Settings& of(const std::string& stage) {
+    std::any& settings = by_stage_[stage];
+    if (!settings.has_value()) settings = Settings{};
+    return std::any_cast<Settings&>(settings);
+  }
+  SegmentSettings& segment() { return of<SegmentSettings>("segment"); }
+  MeshSettings& mesh() { return of<MeshSettings>("mesh"); }
+  SampleSettings& sample() { return of<SampleSettings>("sample"); }
+  FitSettings& fit() { return of<FitSettings>("fit"); }
+  ErrorsSettings& errors() { return of<ErrorsSettings>("errors"); }
+  subject::SubjectReportOptions& report() { return of<subject::SubjectReportOptions>("report"); }
+
+ private:
+  std::map<std::string, std::any> by_stage_;
 };
 
 /// The field an option sets; its type is the option's.
