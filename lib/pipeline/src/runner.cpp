@@ -196,7 +196,12 @@ std::string hashInput(const fs::path& path) {
 
 json stageStamp(const StagePlan& plan, KnownHashes* known) {
   // Another build of articula reruns every stage: its outputs may differ.
-  json stamp = {{"articula", versionString()}, {"args", plan.arguments}, {"inputs", json::object()}};
+  // How much a stage logs does not change them: --quiet and --verbose are
+  // no part of its stamp.
+  std::vector<std::string> args;
+  for (const std::string& a : plan.arguments)
+    if (a != "--quiet" && a != "--verbose") args.push_back(a);
+  json stamp = {{"articula", versionString()}, {"args", args}, {"inputs", json::object()}};
   for (const auto& in : plan.inputs) stamp["inputs"][in.string()] = hashOnce(in, known);
   return stamp;
 }

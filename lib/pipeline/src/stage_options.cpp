@@ -30,13 +30,7 @@ namespace {
 // The settings field an option binds: `FIELD(segment().head.hu_min)`.
 #define FIELD(path) [](StageSettings& s) -> OptionField { return &s.path; }
 
-StageOption option(std::string name, OptionField (*field)(StageSettings&), std::string help) {
-  StageOption o;
-  o.name = std::move(name);
-  o.field = field;
-  o.help = std::move(help);
-  return o;
-}
+constexpr auto option = stageOption;
 
 std::vector<std::string> modelNames() {
   std::vector<std::string> names;
@@ -226,6 +220,14 @@ bool parseWhole(const std::string& text, T& value) {
 
 }  // namespace
 
+StageOption stageOption(std::string name, OptionField (*field)(StageSettings&), std::string help) {
+  StageOption o;
+  o.name = std::move(name);
+  o.field = field;
+  o.help = std::move(help);
+  return o;
+}
+
 std::string typeName(OptionType type) {
   switch (type) {
     case OptionType::Number: return "number";
@@ -357,8 +359,7 @@ nlohmann::json StageOption::json() const {
 const std::vector<StageOption>& stageOptions(const std::string& stage) {
   const auto& table = declarations();
   const auto it = table.find(stage);
-  if (it == table.end()) throw UsageError("unknown stage '" + stage + "': expected one of " + stageNames());
-  return it->second;
+  return it != table.end() ? it->second : stageNamed(stage).options;  // a stage registered from its own file
 }
 
 std::vector<StageOptionOf> optionsRunAs(const std::string& run_name) {

@@ -3,6 +3,7 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <map>
 
 #include <system_error>
 #include <utility>
@@ -11,12 +12,74 @@
 
 namespace articula::pipeline {
 
+namespace {
+
+std::vector<StageDescription (*)()>& registeredStages() {
+  static std::vector<StageDescription (*)()> list;
+  return list;
+}
+
+// The stages in an order that runs every stage after those that write its
+// inputs: of the stages ready to run, the one listed first (the pipeline's
+// own in their order, then those registered, by name).
+std::vector<StageDescription> inRunOrder(std::vector<StageDescription> listed) {
+  std::map<std::string, size_t> writer;
+  for (size_t i = 0; i < listed.size(); ++i) {
+    for (const std::string& file : listed[i].outputs) {
+      const auto [at, added] = writer.emplace(file, i);
+      if (!added)
+        throw ProcessingError("stages '" + listed[at->second].name + "' and '" + listed[i].name + "' both write " + file);
+    }
+    for (size_t j = 0; j < i; ++j)
+      if (listed[j].name == listed[i].name) throw ProcessingError("two stages are named '" + listed[i].name + "'");
+  }
+  std::vector<std::vector<size_t>> after(listed.size());  // the stages each one waits for
+  for (size_t i = 0; i < listed.size(); ++i)
+    for (const std::string& file : listed[i].inputs) {
+      if (file == "CT") continue;
+      const auto at = writer.find(file);
+      if (at == writer.end()) throw ProcessingError("stage '" + listed[i].name + "' reads " + file + ", which no stage writes");
+      after[i].push_back(at->second);
+    }
+  std::vector<StageDescription> ordered;
+  std::vector<char> placed(listed.size(), 0);
+  while (ordered.size() < listed.size()) {
+    size_t next = listed.size();
+    for (size_t i = 0; i < listed.size() && next == listed.size(); ++i)
+      if (!placed[i] && std::all_of(after[i].begin(), after[i].end(), [&placed](size_t j) { return placed[j] != 0; }))
+        next = i;
+    if (next == listed.size()) throw ProcessingError("the stages' inputs and outputs form a cycle");
+    placed[next] = 1;
+    ordered.push_back(listed[next]);
+  }
+  return ordered;
+}
+
+}  // namespace
+
+bool registerStage(StageDescription (*describe)()) {
+  registeredStages().push_back(describe);
+  return true;
+}
+
 const std::vector<StageDescription>& stages() {
+  static const std::vector<StageDescription> table = [] {
+    std::vector<StageDescription> listed = pipelineStages();
+    std::vector<StageDescription> added;
+    for (const auto describe : registeredStages()) added.push_back(describe());
+    std::sort(added.begin(), added.end(), [](const StageDescription& a, const StageDescription& b) { return a.name < b.name; });
+    listed.insert(listed.end(), added.begin(), added.end());
+    return inRunOrder(std::move(listed));
+  }();
+  return table;
+}
+
+std::vector<StageDescription> pipelineStages() {
   // Threads and memory: what a job of the stage needs on a clinical CT
   // (512 x 512 x 400 voxels: segment, mesh and report peak at 1.1-1.2 GB,
   // the CT read as floats; sample, fit and errors at 60 MB with 4,000 points,
   // fit 670 MB with 10^6), rounded up.
-  static const std::vector<StageDescription> table = {
+  return {
       {"segment",
        "Segment the joint head from a CT (label image)",
        stageOptions("segment"),
@@ -68,7 +131,6 @@ const std::vector<StageDescription>& stages() {
        {"slicer/*.mrk.json"},
        1, 2000},
   };
-  return table;
 }
 
 const StageDescription& stageNamed(const std::string& name) {

@@ -127,6 +127,16 @@ struct StageOption {
   nlohmann::json json() const;
 };
 
+/// A stage option bound to a settings field, to be narrowed with in(),
+/// oneOf(), unitIs() ...: stageOption("hu-min", FIELD, "help").in(-2000, 10000).
+StageOption stageOption(std::string name, OptionField (*field)(StageSettings&), std::string help);
+
+/// The field of a stage's own settings struct an option binds, for stages
+/// declared in a file of their own (stages.hpp):
+/// ARTICULA_STAGE_FIELD(RadiiSettings, "radii", scale).
+#define ARTICULA_STAGE_FIELD(Settings, stage, member) \
+  [](::articula::pipeline::StageSettings& s) -> ::articula::pipeline::OptionField { return &s.of<Settings>(stage).member; }
+
 /// The options of the named stage, in the order of its --help.
 const std::vector<StageOption>& stageOptions(const std::string& stage);
 

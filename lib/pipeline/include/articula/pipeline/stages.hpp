@@ -5,14 +5,22 @@
 // the Snakemake workflow (declared in stage_options.hpp). The runner
 // (runner.hpp, `articula run`) chains the stages from it, `articula stages
 // --json` prints it, and pipelines/Snakefile makes one rule per stage from
-// that print. Adding a stage: its command in apps/, one row here, its
-// options there.
+// that print.
+//
+// The pipeline's own six stages are listed in stages.cpp, their options in
+// stage_options.cpp. A stage may also come in one file of its own: its
+// command, its settings struct, a function returning its row (its options
+// bound with stageOption and ARTICULA_STAGE_FIELD) and the line
+// ARTICULA_REGISTER_STAGE(Command, describe). It takes its place in the run
+// order by the files it reads and writes, and run, stages --json, manifests
+// and the Snakefile take it from the table.
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "articula/cli/command.hpp"
 #include "articula/pipeline/stage_options.hpp"
 
 namespace articula::pipeline {
@@ -39,8 +47,22 @@ struct StageDescription {
 std::vector<std::string> expandArguments(const StageDescription& stage, const std::string& ct, const std::string& folder,
                                          const std::string& joint, const std::string& side);
 
-/// segment, mesh, sample, fit, errors, report.
+/// Every stage in run order: each after the stages that write its inputs
+/// (segment, mesh, sample, fit, errors, report, and those registered). A
+/// file two stages write, an input no stage writes or a cycle is refused
+/// (ProcessingError).
 const std::vector<StageDescription>& stages();
+
+/// The pipeline's own stages, in their order.
+std::vector<StageDescription> pipelineStages();
+
+/// Adds a stage declared in its own file to the table (before main: through
+/// ARTICULA_REGISTER_STAGE, with its command of the same name).
+bool registerStage(StageDescription (*describe)());
+
+#define ARTICULA_REGISTER_STAGE(Class, describe) \
+  ARTICULA_REGISTER_COMMAND(Class)               \
+  [[maybe_unused]] const bool articula_registered_stage_##Class = ::articula::pipeline::registerStage(describe);
 
 /// The named stage; throws UsageError naming the stages when there is none.
 const StageDescription& stageNamed(const std::string& name);
