@@ -20,15 +20,15 @@ bin, ct, tmp = sys.argv[1:]
 stages = json.load(open(os.path.join(tmp, "stages.json")))["stages"]
 help_text = open(os.path.join(tmp, "run-help.txt")).read()
 missing = os.path.join(tmp, "missing")
-# Each stage's command line with an input that does not exist.
-wiring = {
-    "segment": ["-i", missing, "-o", f"{tmp}/x/label.nii.gz"],
-    "mesh": ["-i", missing + ".nii.gz", "-o", f"{tmp}/x/bone.vtp"],
-    "sample": ["-i", missing + ".vtp", "-o", f"{tmp}/x/points.ply"],
-    "fit": ["-i", missing + ".ply", "-o", f"{tmp}/x/fits.json"],
-    "errors": ["-i", missing + ".ply", "--fits", missing + ".json", "-o", f"{tmp}/x/errors"],
-    "report": ["-i", missing],
-}
+# Each stage's command line from the table, its inputs missing.
+def wiring(stage):
+    fields = {"{CT}": missing, "{folder}": os.path.join(tmp, "missing-folder"), "{joint}": "hip", "{side}": "right"}
+    args = []
+    for a in stage["arguments"]:
+        for key, value in fields.items():
+            a = a.replace(key, value)
+        args.append(a)
+    return args
 # Values for the options without a default.
 examples = {"seed-point": "1,2,3", "roi": "-60,-60,-60,60,60,60", "series-uid": "1.2.3",
             "label": f"{tmp}/femur.nii.gz", "bounds": f"{tmp}/bounds.json"}
@@ -55,7 +55,7 @@ for stage in stages:
         assert value is not None, f"no value to try for {stage['name']} --{name}"
         given = [f"--{name}"] if kind == "flag" else [f"--{name}", value]
         # The stage's own command.
-        r = articula(stage["name"], *wiring[stage["name"]], *given)
+        r = articula(stage["name"], *wiring(stage), *given)
         assert r.returncode == 3, (stage["name"], given, r.returncode, r.stderr)
         # run, under its run name: the stage gets it, under its own.
         run_given = [f"--{run_name}"] if kind == "flag" else [f"--{run_name}", value]
