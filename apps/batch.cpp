@@ -47,17 +47,14 @@ class BatchCommand : public cli::Command {
     app.add_option("-j,--jobs", jobs_, "Subjects run in parallel")->check(CLI::PositiveNumber)->capture_default_str();
     app.add_flag("--validate", validate_only_, "Check the manifest and the inputs, run nothing");
     app.add_flag("--gather-only", gather_only_, "Only rebuild the study tables from the subjects' folders");
+    app.add_flag("--list", list_,
+                 "Print the manifest's subjects as JSON (id, input, joint, side, the options each subject's run "
+                 "gets from its columns) once its cells are checked, and run nothing (the Snakemake workflow reads it)");
     app.add_option("--subject-config", subject_config_, "CLI11 config file passed to every subject's run");
   }
 
   int run(const cli::CommonOptions& common) override {
     const auto subjects = pipeline::readManifest(manifest_);
-    int problems = 0;
-    for (const auto& s : subjects)
-      for (const auto& p : pipeline::checkSubjectInput(s, validate_only_)) {
-        log::warn(manifest_.string() + ":" + std::to_string(s.line) + ": subject " + s.id + ": " + p);
-        ++problems;
-      }
     pipeline::BatchOptions options;
     options.study_dir = study_dir_;
     options.seed = common.seed;
@@ -70,6 +67,20 @@ class BatchCommand : public cli::Command {
         throw InputError(manifest_.string() + ":" + std::to_string(s.line) + ": subject " + s.id +
                          ": its options do not parse as 'articula run' options: " + excerpt(problem, 200));
     }
+    if (list_) {
+      nlohmann::json listed = nlohmann::json::array();
+      for (const auto& s : subjects)
+        listed.push_back({{"id", s.id}, {"input", s.input.string()}, {"joint", s.joint}, {"side", s.side},
+                          {"options", s.options}, {"line", s.line}});
+      cli::printJson({{"manifest", manifest_.string()}, {"subjects", listed}});
+      return 0;
+    }
+    int problems = 0;
+    for (const auto& s : subjects)
+      for (const auto& p : pipeline::checkSubjectInput(s, validate_only_)) {
+        log::warn(manifest_.string() + ":" + std::to_string(s.line) + ": subject " + s.id + ": " + p);
+        ++problems;
+      }
     if (validate_only_) {
       if (common.json) cli::printJson({{"subjects", subjects.size()}, {"problems", problems}});
       if (problems) throw InputError(std::to_string(problems) + " subject input problem(s) in " + manifest_.string());
@@ -128,7 +139,7 @@ class BatchCommand : public cli::Command {
 
   fs::path manifest_, study_dir_, subject_config_;
   int jobs_ = 1;
-  bool validate_only_ = false, gather_only_ = false;
+  bool validate_only_ = false, gather_only_ = false, list_ = false;
 };
 
 ARTICULA_REGISTER_COMMAND(BatchCommand)
