@@ -1,6 +1,5 @@
 // Batch manifests and the CSV they are read with.
 #include <filesystem>
-#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -12,24 +11,19 @@
 namespace p = articula::pipeline;
 namespace fs = std::filesystem;
 using articula::testsupport::scratchDir;
-
-namespace {
-void write(const fs::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
-}  // namespace
+using articula::testsupport::writeText;
 
 TEST(Csv, QuotedFieldsRoundTrip) {
   const fs::path dir = scratchDir("csv");
   const std::vector<std::string> fields = {"plain", "with,comma", "with \"quotes\"", "", "multi\nline"};
-  write(dir / "t.csv", "a,b,c,d,e\n" + articula::csvLine(fields) + "\n# comment\n\n1,2\n");
+  writeText(dir / "t.csv", "a,b,c,d,e\n" + articula::csvLine(fields) + "\n# comment\n\n1,2\n");
   const articula::CsvTable t = articula::readCsv(dir / "t.csv");
   ASSERT_EQ(t.rows.size(), 2u);
   EXPECT_EQ(t.rows[0], fields);
   EXPECT_EQ(t.rows[1][1], "2");
   EXPECT_EQ(t.rows[1][4], "");
   EXPECT_EQ(t.row_lines[1], 6);
-  write(dir / "bad.csv", "a,b\n1,2,3\n");
+  writeText(dir / "bad.csv", "a,b\n1,2,3\n");
   try {
     articula::readCsv(dir / "bad.csv");
     FAIL();
@@ -41,8 +35,8 @@ TEST(Csv, QuotedFieldsRoundTrip) {
 TEST(Manifest, ResolvesPathsAndOptions) {
   const fs::path dir = scratchDir("manifest");
   fs::create_directories(dir / "data");
-  write(dir / "data" / "s1.nii.gz", "x");
-  write(dir / "m.csv", "subject,input,joint,side,seed_point\ns1,data/s1.nii.gz,hip,left,\"1,2,3\"\ns2," +
+  writeText(dir / "data" / "s1.nii.gz", "x");
+  writeText(dir / "m.csv", "subject,input,joint,side,seed_point\ns1,data/s1.nii.gz,hip,left,\"1,2,3\"\ns2," +
                            (dir / "missing").string() + ",shoulder,right,\n");
   const auto subjects = p::readManifest(dir / "m.csv");
   ASSERT_EQ(subjects.size(), 2u);
@@ -54,7 +48,7 @@ TEST(Manifest, ResolvesPathsAndOptions) {
   EXPECT_NE(p::checkSubjectInput(subjects[1])[0].find("does not exist"), std::string::npos);
 
   auto rejects = [&](const std::string& text, const std::string& fragment) {
-    write(dir / "bad.csv", text);
+    writeText(dir / "bad.csv", text);
     try {
       p::readManifest(dir / "bad.csv");
       ADD_FAILURE() << "accepted: " << text;
@@ -80,7 +74,7 @@ TEST(Manifest, ResolvesPathsAndOptions) {
   rejects("subject,input,joint,side,min_radius\na,x,hip,left,70\n", "the segment stage: --min-radius (mm)");
   rejects("subject,input,joint,side,seed_point\na,x,hip,left,\"1,2\"\n", "expected 3 numbers");
   rejects("subject,input,joint,side,all_components\na,x,hip,left,yes\n", "expected true or false, found 'yes'");
-  write(dir / "flags.csv", "subject,input,joint,side,all_components,errors_band\na,x,hip,left,true,0.3\nb,x,hip,left,false,\n");
+  writeText(dir / "flags.csv", "subject,input,joint,side,all_components,errors_band\na,x,hip,left,true,0.3\nb,x,hip,left,false,\n");
   const auto flagged = p::readManifest(dir / "flags.csv");
   EXPECT_EQ(flagged[0].options, (std::vector<std::string>{"--all-components", "--errors-band", "0.3"}));
   EXPECT_TRUE(flagged[1].options.empty());
@@ -88,11 +82,11 @@ TEST(Manifest, ResolvesPathsAndOptions) {
 
 TEST(Manifest, SpreadsheetByteOrderMarkIsNoPartOfTheHeader) {
   const fs::path dir = scratchDir("manifest_bom");
-  write(dir / "m.csv", "\xEF\xBB\xBFsubject,input,joint,side\ns1,a.nii,hip,left\n");
+  writeText(dir / "m.csv", "\xEF\xBB\xBFsubject,input,joint,side\ns1,a.nii,hip,left\n");
   const auto subjects = p::readManifest(dir / "m.csv");
   ASSERT_EQ(subjects.size(), 1u);
   EXPECT_EQ(subjects[0].id, "s1");
-  write(dir / "m.csv", "\xEF\xBB\xBFid,input,joint,side\ns1,a.nii,hip,left\n");
+  writeText(dir / "m.csv", "\xEF\xBB\xBFid,input,joint,side\ns1,a.nii,hip,left\n");
   try {
     p::readManifest(dir / "m.csv");
     ADD_FAILURE() << "accepted a header without subject";

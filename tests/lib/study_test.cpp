@@ -1,7 +1,5 @@
 // The study's tables and figures from its subjects' results.
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -12,17 +10,9 @@
 
 namespace p = articula::pipeline;
 namespace fs = std::filesystem;
+using articula::testsupport::readText;
 using articula::testsupport::scratchDir;
-
-namespace {
-void write(const fs::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
-std::string readText(const fs::path& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-}  // namespace
+using articula::testsupport::writeText;
 
 TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
   const fs::path dir = scratchDir("study");
@@ -43,7 +33,7 @@ TEST(StudyTables, FigureShowsEverySubjectsRmsAndTheMeans) {
                         {"aic", -100.0 * (m + 1)},
                         {"bic", -90.0 * (m + 1)}});
     fs::create_directories(p::subjectDir(dir, ids[i]));
-    write(p::subjectDir(dir, ids[i]) / "results.json",
+    writeText(p::subjectDir(dir, ids[i]) / "results.json",
           nlohmann::json({{"best_model", "ellipsoid"},
                           {"selected_model", "sphere"},
                           {"joint", "hip"},

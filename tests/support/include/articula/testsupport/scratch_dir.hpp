@@ -1,8 +1,11 @@
 #pragma once
 // A test program's scratch folders: <temp>/articula-test-<pid>/<name>, made
 // fresh by each call; the program's whole folder is removed when it ends
-// (failed tests included), so test runs leave nothing in the temp dir.
+// (failed tests included), so test runs leave nothing in the temp dir. And
+// the text of the files a test writes there and reads back.
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <system_error>
 
@@ -24,6 +27,13 @@ inline std::filesystem::path scratchDir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+inline void writeText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+inline std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace articula::testsupport
