@@ -88,7 +88,9 @@ TEST(CapDepartures, AFlattenedDomeIsMeasuredInAreaAndDepth) {
   for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v) {
     const bool deep = std::abs(c.local(v).z() - plane) < 1e-9 && c.local(v).norm() < kRadius - t - 1e-6;
     const bool edge = std::abs(c.local(v).norm() - (kRadius - t)) < 0.05;  // rounding at the border
-    if (!edge) EXPECT_EQ(d.region_of_vertex[static_cast<size_t>(v)], deep ? 0 : -1) << v;
+    if (!edge) {
+      EXPECT_EQ(d.region_of_vertex[static_cast<size_t>(v)], deep ? 0 : -1) << v;
+    }
   }
 }
 

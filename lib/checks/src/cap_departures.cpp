@@ -68,7 +68,7 @@ CapDirections capDirections(const Eigen::MatrixX3d& unit_points) {
   cap.directions.resize(n, 3);
   for (int i = 0; i < n; ++i) cap.directions.row(i) = geometry::fibonacciDirection(i, n).transpose();
   std::vector<char> held(static_cast<size_t>(n), 0);
-  for (Eigen::Index i = 0; i < unit_points.rows(); ++i) held[static_cast<size_t>(cap.nearest(unit_points.row(i).transpose()))] = 1;
+  for (Eigen::Index i = 0; i < unit_points.rows(); ++i) held.at(static_cast<size_t>(cap.nearest(unit_points.row(i).transpose()))) = 1;
   // Neighbours: within 1.8 lattice spacings (the lattice's spacing is about sqrt(4 pi / n)).
   const double neighbour_cos = std::cos(1.8 * std::sqrt(4 * M_PI / n));
   const auto cosine = [&cap](int i, int j) { return cap.directions.row(i).dot(cap.directions.row(j)); };
@@ -254,8 +254,8 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
     sorted.push_back(out.regions[static_cast<size_t>(order[k])]);
   }
   out.regions = std::move(sorted);
-  for (int& r : region_of_vertex)
-    if (r >= 0) r = rank[static_cast<size_t>(r)];
+  for (int& region : region_of_vertex)
+    if (region >= 0) region = rank[static_cast<size_t>(region)];
   out.region_of_vertex = std::move(region_of_vertex);
   return out;
 }

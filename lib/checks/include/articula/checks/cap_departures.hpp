@@ -15,7 +15,6 @@
 #include <nlohmann/json.hpp>
 
 #include "articula/geometry/shape.hpp"
-#include "articula/imaging/image.hpp"
 
 namespace articula::checks {
 
@@ -58,7 +57,6 @@ struct CapDepartureInput {
   geometry::ShapeParameters model;  // the selected fit
   Eigen::MatrixX3d points;     // the articular points it was fitted to
   double voxel_mm = 0;         // the CT's largest spacing, if known: the threshold is at least 0.3 voxel
-  const imaging::Volume* ct = nullptr;  // if given: vertices where bone goes on outside (the label's cut across the neck) are left out
   std::optional<Eigen::Vector3d> medial;  // a hip's medial direction (towards the body's middle): where its fovea lies
 };
 
