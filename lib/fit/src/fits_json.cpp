@@ -140,4 +140,19 @@ std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& 
   return shapes;
 }
 
+nlohmann::json fitsDocument(const Summary& summary, const std::string& input, const std::string& objective,
+                            const nlohmann::json& provenance) {
+  nlohmann::json models = nlohmann::json::array();
+  for (const auto& f : summary.fits) models.push_back(modelFitJson(f));
+  return {{"coordinate_system", "LPS"},
+          {"units", "mm"},
+          {"input", input},
+          {"n_points", summary.points},
+          {"objective", objective},
+          {"least_rms_model", summary.best_model},
+          {"seconds", summary.seconds},
+          {"models", models},
+          {"provenance", provenance}};
+}
+
 }  // namespace articula::fit

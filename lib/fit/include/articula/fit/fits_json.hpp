@@ -16,6 +16,12 @@ namespace articula::fit {
 /// One entry of fits.json "models".
 nlohmann::json modelFitJson(const ModelFit& fit);
 
+/// The whole fits.json document of a fitted hierarchy: LPS mm, the points'
+/// file and count, the objective, the least-RMS model, every model's entry
+/// and `provenance` (core/provenance.hpp's JSON).
+nlohmann::json fitsDocument(const Summary& summary, const std::string& input, const std::string& objective,
+                            const nlohmann::json& provenance);
+
 /// The shape of one fits.json "models" entry; throws InputError naming the
 /// missing or malformed key and `where` (e.g. the file name and index).
 geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where);
