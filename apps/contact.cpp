@@ -34,15 +34,6 @@ using contact::ContactResult;
 using contact::ConvexShape;
 using Eigen::Vector3d;
 
-const char* kOutputHeader = "distance,pax,pay,paz,pbx,pby,pbz,nx,ny,nz,iterations,status";
-
-// One output row; `suffix` (e.g. ",123.4") goes before the newline.
-void writeRow(std::ostream& out, const ContactResult& r, const std::string& suffix = "") {
-  out << r.distance;
-  for (const Vector3d* v : {&r.point_a, &r.point_b, &r.normal}) out << ',' << (*v)[0] << ',' << (*v)[1] << ',' << (*v)[2];
-  out << ',' << r.summary.iterations << ',' << contact::statusName(r.summary.status) << suffix << '\n';
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
@@ -152,7 +143,7 @@ class ContactCommand : public cli::Command {
 
     AtomicFile file(output_, common.force);
     std::ostream& out = file.stream();
-    out << kOutputHeader << '\n' << std::setprecision(17);
+    out << contact::kResultsCsvHeader << '\n' << std::setprecision(17);
     // The rows are independent: solved over --threads, written in order
     // (the same file for any thread count).
     std::vector<ContactResult> results(pairs.size());
@@ -186,7 +177,7 @@ class ContactCommand : public cli::Command {
       const ContactResult& r = results[i];
       ns.push_back(row_ns[i]);
       planes += pair.plane;
-      writeRow(out, r);
+      contact::writeResultRow(out, r);
       iterations += r.summary.iterations;
       converged += r.summary.status == contact::ContactStatus::Converged;
       certified += r.summary.certified;
@@ -214,7 +205,7 @@ class ContactCommand : public cli::Command {
   int runScenario(const cli::CommonOptions& common) {
     AtomicFile file(output_, common.force);
     std::ostream& out = file.stream();
-    out << "step," << kOutputHeader << ",ns\n" << std::setprecision(17);
+    out << "step," << contact::kResultsCsvHeader << ",ns\n" << std::setprecision(17);
     std::vector<double> ns;
     long long iterations = 0;
     int converged = 0, max_iterations = 0;
@@ -225,7 +216,7 @@ class ContactCommand : public cli::Command {
       const double t = timeNs([&] { r = contact::computeContact(p.i, p.j, options_, k ? &previous : nullptr); }, 1);
       ns.push_back(t);
       out << k << ',';
-      writeRow(out, r, "," + std::to_string(t));
+      contact::writeResultRow(out, r, "," + std::to_string(t));
       if (k) iterations += r.summary.iterations;
       max_iterations = std::max(max_iterations, r.summary.iterations);
       converged += r.summary.status == contact::ContactStatus::Converged;
@@ -263,8 +254,8 @@ class ContactCommand : public cli::Command {
     ContactResult r;
     const double t = timeNs([&] { r = contact::computeContact(a, b, options_); });
     AtomicFile file(output_, common.force);
-    file.stream() << kOutputHeader << '\n' << std::setprecision(17);
-    writeRow(file.stream(), r);
+    file.stream() << contact::kResultsCsvHeader << '\n' << std::setprecision(17);
+    contact::writeResultRow(file.stream(), r);
     file.commit();
     nlohmann::json summary = {{"output", output_.string()},
                               {"distance_mm", r.distance},

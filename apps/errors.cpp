@@ -15,7 +15,6 @@
 #include "articula/core/error.hpp"
 #include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
-#include "articula/core/number_text.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/fit/fits_json.hpp"
@@ -144,28 +143,9 @@ class ErrorsCommand : public cli::Command {
     nlohmann::json params = {{"fits", fits_.string()}, {"band_mm", given.band_mm}, {"resolution", given.resolution}};
     const nlohmann::json provenance = provenanceJson({params, {input_, fits_}, -1});
     writeFileAtomically(output_ / "summary.csv", report::summaryCsv(rows), overwrite);
-    {
-      AtomicFile file(output_ / "errors.csv", overwrite);
-      std::ostream& out = file.stream();
-      out << "x_mm,y_mm,z_mm";
-      for (const auto& s : shapes) out << ",d_" << geometry::modelName(s.model) << "_mm";
-      out << "\n";
-      std::string row;
-      for (Eigen::Index i = 0; i < P.rows(); ++i) {
-        row.clear();
-        for (int k = 0; k < 3; ++k) {
-          if (k) row += ',';
-          appendNumber(row, P(i, k));
-        }
-        for (Eigen::Index m = 0; m < all.cols(); ++m) {
-          row += ',';
-          appendNumber(row, all(i, m));
-        }
-        row += '\n';
-        out << row;
-      }
-      file.commit();
-    }
+    std::vector<std::string> model_names;
+    for (const auto& shape : shapes) model_names.push_back(geometry::modelName(shape.model));
+    report::writeErrorsCsv(output_ / "errors.csv", P, model_names, all, overwrite);
     writeFileAtomically(output_ / "histogram.svg",
                         report::histogramSvg(series, "Signed Euclidean distances of the points to each model"),
                         overwrite);

@@ -131,4 +131,11 @@ std::vector<PairRow> readPairsCsv(const std::filesystem::path& path) {
   return rows;
 }
 
+void writeResultRow(std::ostream& out, const ContactResult& result, const std::string& suffix) {
+  out << result.distance;
+  for (const Eigen::Vector3d* v : {&result.point_a, &result.point_b, &result.normal})
+    out << ',' << (*v)[0] << ',' << (*v)[1] << ',' << (*v)[2];
+  out << ',' << result.summary.iterations << ',' << statusName(result.summary.status) << suffix << '\n';
+}
+
 }  // namespace articula::contact

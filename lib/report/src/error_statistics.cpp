@@ -4,7 +4,9 @@
 #include <iomanip>
 #include <sstream>
 
+#include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/number_text.hpp"
 
 namespace articula::report {
 
@@ -61,6 +63,30 @@ nlohmann::json summaryJson(const std::vector<ErrorStatistics>& rows) {
                      {"gauss_sigma_mm", r.gauss_sigma_mm},
                      {"sse_mm2", r.sse_mm2}});
   return array;
+}
+
+void writeErrorsCsv(const std::filesystem::path& path, const Eigen::MatrixX3d& points, const std::vector<std::string>& models,
+                    const Eigen::MatrixXd& distances, bool overwrite) {
+  AtomicFile file(path, overwrite);
+  std::ostream& out = file.stream();
+  out << "x_mm,y_mm,z_mm";
+  for (const auto& name : models) out << ",d_" << name << "_mm";
+  out << "\n";
+  std::string row;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    row.clear();
+    for (int k = 0; k < 3; ++k) {
+      if (k) row += ',';
+      appendNumber(row, points(i, k));
+    }
+    for (Eigen::Index m = 0; m < distances.cols(); ++m) {
+      row += ',';
+      appendNumber(row, distances(i, m));
+    }
+    row += '\n';
+    out << row;
+  }
+  file.commit();
 }
 
 }  // namespace articula::report

@@ -1,16 +1,19 @@
 #pragma once
-// The --pairs CSV of `articula contact` (docs/formats.md): a header row, then
+// The CSV files of `articula contact` (docs/formats.md): its results, a row
+// per query, and its --pairs input: a header row, then
 // one query per row: cx_a,cy_a,cz_a,qw_a,qx_a,qy_a,qz_a,ra_a,rb_a,rc_a,
 // g1_a,g2_a,g3_a and the same with _b (quaternion w,x,y,z; exponents 2 =
 // ellipsoid); an optional column shape_b: 'plane' takes b as the plane
 // through cx_b,cy_b,cz_b with normal nx_b,ny_b,nz_b; 'sphere' or 'ellipsoid'
 // may leave g1_b,g2_b,g3_b empty (and a sphere needs equal radii).
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "articula/contact/common_normal.hpp"
 #include "articula/contact/convex_shape.hpp"
 
 namespace articula::contact {
@@ -36,5 +39,13 @@ struct PairRow {
 /// non-finite number, a zero quaternion, an unknown shape_b, values outside
 /// makeConvexShape's range.
 std::vector<PairRow> readPairsCsv(const std::filesystem::path& path);
+
+/// The results' columns: the signed distance, the closest points of a and
+/// b, the common normal, the solver's iterations and status.
+inline constexpr const char* kResultsCsvHeader = "distance,pax,pay,paz,pbx,pby,pbz,nx,ny,nz,iterations,status";
+
+/// One results row at the stream's precision; `suffix` (e.g. ",123.4") goes
+/// before the newline.
+void writeResultRow(std::ostream& out, const ContactResult& result, const std::string& suffix = "");
 
 }  // namespace articula::contact

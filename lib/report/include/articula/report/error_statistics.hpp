@@ -1,5 +1,6 @@
 #pragma once
 // Statistics of signed surface errors, as thesis tables 3.3 and 3.4.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,13 @@ ErrorStatistics errorStatistics(const std::string& model, const Eigen::VectorXd&
 const std::vector<std::string>& summaryColumns();
 /// summary.csv: a header row then one row per model.
 std::string summaryCsv(const std::vector<ErrorStatistics>& rows);
+
+/// errors.csv: a row per point, x_mm,y_mm,z_mm and its signed distance to
+/// each model (d_<model>_mm: `distances` holds a column per name of
+/// `models`), written atomically to `path` (refused if it exists, unless
+/// `overwrite`).
+void writeErrorsCsv(const std::filesystem::path& path, const Eigen::MatrixX3d& points, const std::vector<std::string>& models,
+                    const Eigen::MatrixXd& distances, bool overwrite);
 /// One JSON object per row, keyed by summaryColumns().
 nlohmann::json summaryJson(const std::vector<ErrorStatistics>& rows);
 
