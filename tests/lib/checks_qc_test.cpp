@@ -110,6 +110,19 @@ TEST(HeadQc, ASearchThatFoundAnotherStructureFails) {
   EXPECT_EQ(check(r, "search_radius_difference_relative").status, "fail");
 }
 
+// The search's sphere right, the points on a larger surface (head and socket
+// joined in the label): the radii 16 % apart fail, 10 % apart warn.
+TEST(HeadQc, ASearchRadiusFarFromTheFitsFails) {
+  checks::HeadQcInput in = cap(23, 85);
+  in.search_center = in.sphere_center;
+  in.search_radius_mm = 23.0 * 0.84;
+  EXPECT_EQ(check(checks::checkHead(in), "search_radius_difference_relative").status, "fail");
+  in.search_radius_mm = 23.0 * 0.90;
+  EXPECT_EQ(check(checks::checkHead(in), "search_radius_difference_relative").status, "warn");
+  in.search_radius_mm = 23.0 * 0.97;
+  EXPECT_EQ(check(checks::checkHead(in), "search_radius_difference_relative").status, "pass");
+}
+
 TEST(HeadQc, AnUnverifiedSideWarns) {
   checks::HeadQcInput in = cap(23, 85);
   in.side_verified = true;

@@ -21,7 +21,13 @@ constexpr double kCapFailDeg = 30, kCapWarnDeg = 45;
 constexpr double kOutwardFail = 0.90, kOutwardWarn = 0.97;
 constexpr double kRmsWarn = 0.04, kRmsFail = 0.08;            // of the radius
 constexpr double kCentreWarn = 0.15, kCentreFail = 0.30;      // search vs fit, of the radius
-constexpr double kRadiusWarn = 0.15, kRadiusFail = 0.30;      // relative difference
+// The search's radius against the fit's, relative: at most 0.038 on 571
+// phantom heads of three generators whose points are right (clipped by the
+// field of view, metal, arthritis, coarse voxels included), 0.016-0.096 on
+// the real CTs (0.096: the thorax's clipped humeral head); 0.156-0.227 where
+// noise of 100 HU joined head and socket in the label and the points lay
+// 4-5 mm out, the search's sphere right.
+constexpr double kRadiusWarn = 0.08, kRadiusFail = 0.15;
 constexpr double kEdgeFail = 0.4, kEdgeWarn = 0.6;            // share of the points on the CT's edge (a 1.5 mm gap and a thin cortex: down to 0.69 on correct heads)
 constexpr double kInsideWarn = 0.15, kInsideFail = 0.30;      // share of the points inside the bone (a 1.5 mm gap at 1 mm voxels: up to 0.12 on correct heads)
 // The cortex's contrast across the slices relative to within them: 0.38-1.05
