@@ -149,6 +149,22 @@ assert "blurred-cortex model" in methods and "estimated from the CT: %.2f mm wit
     edges["point_spread_mm"], edges["slice_point_spread_mm"]) in methods, methods
 PY
 
+# The mesh stage's fallback from the cortex model (no point-spread estimated:
+# the edges on the steepest falls), as its sidecar records it, is a named
+# check of the report, not a terminal line only.
+python3 - "$tmp/r/bone.vtp.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["ct_edges"]["cortex_model_note"] = "the CT's point-spread could not be estimated from 12 edges; the edges are the steepest falls"
+json.dump(d, open(sys.argv[1], "w"), indent=2)
+PY
+expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
+python3 - "$tmp/r/results.json" <<'PY'
+import json, sys
+check = next(c for c in json.load(open(sys.argv[1]))["qc"]["checks"] if c["name"] == "stage_warnings")
+assert check["status"] == "warn" and "mesh: the CT's point-spread could not be estimated" in check["reason"], check
+PY
+
 # A missing stage output: exit 3, named; nothing written.
 mkdir -p "$tmp/r2/errors"
 cp "$tmp/r/points.ply" "$tmp/r2/"

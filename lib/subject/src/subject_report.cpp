@@ -114,6 +114,11 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
     if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("moved") &&
         mesh.at("ct_edges").at("moved").is_boolean())
       in.surface_on_ct_edges = mesh.at("ct_edges").at("moved").get<bool>();
+    // The edges' model fallen back to the steepest falls (no point-spread
+    // estimated): a named check, not the mesh stage's terminal line only.
+    if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("cortex_model_note") &&
+        mesh.at("ct_edges").at("cortex_model_note").is_string())
+      in.stage_warnings.push_back("mesh: " + mesh.at("ct_edges").at("cortex_model_note").get<std::string>());
   }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
