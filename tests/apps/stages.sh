@@ -49,12 +49,22 @@ grep -q "refusing to overwrite .*results.json" "$tmp/err" || fail "report overwr
 cp "$tmp/r/results.csv" "$tmp/run-results.csv"
 expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
 cmp "$tmp/r/results.csv" "$tmp/run-results.csv" || fail "articula-report and run's report differ"
-python3 - "$tmp/r/results.json" "$selected" <<'PY'
+python3 - "$tmp/r/results.json" "$selected" "$tmp/r/head.mrk.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["selected_model"] == sys.argv[2], (r["selected_model"], sys.argv[2])
 assert "articula-report -i " in r["provenance"]["command"], r["provenance"]["command"]
 assert r["qc"]["status"] in ("pass", "warn"), r["qc"]
+# The head's centre and axes are the selected model's, in results.json and
+# in the Slicer markups alike.
+model = next(m for m in r["models"] if m["model"] == r["selected_model"])
+centre = [model["parameters"][k] for k in ("t1_mm", "t2_mm", "t3_mm")]
+assert max(abs(a - b) for a, b in zip(r["head_center_mm"], centre)) < 1e-9, (r["head_center_mm"], centre)
+markups = json.load(open(sys.argv[3]))["markups"]
+points = markups[0]
+assert points["controlPoints"][0]["label"] == "head_center", points
+assert max(abs(a - b) for a, b in zip(points["controlPoints"][0]["position"], centre)) < 1e-6, points
+assert r["selected_model"] + " head" in json.dumps(markups), [m.get("name") for m in markups]
 PY
 # report.html: self-contained (no script, stylesheet or image from elsewhere;
 # a policy that forbids requests),

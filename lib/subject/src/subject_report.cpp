@@ -337,13 +337,18 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
       f.push_back(m.at("parameters").contains(c) ? number(m.at("parameters").at(c).get<double>()) : "");
     csv_rows += csvLine(f) + "\n";
   }
-  // The head centre and axes of the least-RMS model, for 3D Slicer.
-  const Eigen::Matrix3d R = geometry::rotationFromAngles(best_shape.angles);
-  const Eigen::Vector3d c = best_shape.center;
+  // The head centre and axes of the selected model (one the points
+  // determine, unlike the least-RMS model at times), for 3D Slicer and
+  // results.json.
+  geometry::ShapeParameters selected_shape = best_shape;
+  for (const auto& shape : shapes)
+    if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
+  const Eigen::Matrix3d R = geometry::rotationFromAngles(selected_shape.angles);
+  const Eigen::Vector3d c = selected_shape.center;
   std::vector<LandmarkLine> axes;
   const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
   for (int i = 0; i < 3; ++i)
-    axes.push_back({axis_names[i], c - semiAxes(best_shape)[i] * R.col(i), c + semiAxes(best_shape)[i] * R.col(i)});
+    axes.push_back({axis_names[i], c - semiAxes(selected_shape)[i] * R.col(i), c + semiAxes(selected_shape)[i] * R.col(i)});
 
   json steps_json = json::array(), path_json = json::array();
   for (const statistics::NestedStep& st : selection.steps) steps_json.push_back(stepJson(st));
@@ -351,9 +356,6 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
 
   std::string no_ct;
   const std::shared_ptr<const imaging::Volume> ct = readSubjectCt(o, no_ct);
-  geometry::ShapeParameters selected_shape = best_shape;
-  for (const auto& shape : shapes)
-    if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
   std::optional<points::MeshFile> bone;
   if (fs::exists(o.folder / "bone.vtp")) bone = points::readMeshFile(o.folder / "bone.vtp");
   const std::optional<checks::CapDepartures> departures =
@@ -368,9 +370,9 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
                                " mm2, " + number(std::round(10 * region.depth_mm) / 10) + " mm)",
                            region.centre});
     }
-  writeSlicerMarkups(o.folder / "head.mrk.json", best + " head (articula)", landmarks, axes);
+  writeSlicerMarkups(o.folder / "head.mrk.json", selection.selected + " head (articula)", landmarks, axes);
   SlicerSceneContent scene;
-  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", best + " head (articula)", landmarks, axes);
+  scene.markups = writeSlicerMarkupsPerNode(o.folder / "slicer", selection.selected + " head (articula)", landmarks, axes);
 
   Provenance provenance;
   provenance.inputs = {o.ct.has_filename() && fs::is_regular_file(o.ct) ? o.ct : fs::path(), fits_path, summary_path};
