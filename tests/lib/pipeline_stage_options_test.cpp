@@ -185,3 +185,33 @@ TEST(StageOptions, RunTakesEveryOptionAndPassesOnWhatWasGiven) {
     EXPECT_STREQ(e.what(), "the segment stage: --min-radius (mm): expected 1 to 60, found 70");
   }
 }
+
+// The run order follows the files: a stage after those that write its
+// inputs, whatever order they are listed in; a file two stages write, an
+// input nobody writes and a cycle are refused.
+TEST(StageTable, RunOrderFollowsTheFilesEachStageReadsAndWrites) {
+  const auto row = [](std::string name, std::vector<std::string> in, std::vector<std::string> out) {
+    p::StageDescription s;
+    s.name = std::move(name);
+    s.inputs = std::move(in);
+    s.outputs = std::move(out);
+    return s;
+  };
+  const auto names = [](const std::vector<p::StageDescription>& stages) {
+    std::vector<std::string> n;
+    for (const auto& s : stages) n.push_back(s.name);
+    return n;
+  };
+  const auto a = row("a", {"CT"}, {"a.out"}), b = row("b", {"a.out"}, {"b.out"}), c = row("c", {"b.out", "a.out"}, {"c.out"});
+  const auto side = row("side", {"a.out"}, {"side.out"});
+  EXPECT_EQ(names(p::inRunOrder({c, b, a})), (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_EQ(names(p::inRunOrder({a, side, b, c})), (std::vector<std::string>{"a", "side", "b", "c"}));
+  EXPECT_EQ(names(p::inRunOrder({a, b, c, side})), (std::vector<std::string>{"a", "b", "c", "side"}));
+  EXPECT_THROW(p::inRunOrder({a, b, row("again", {"CT"}, {"b.out"})}), articula::ProcessingError);
+  EXPECT_THROW(p::inRunOrder({a, row("lost", {"nowhere.out"}, {"x"})}), articula::ProcessingError);
+  EXPECT_THROW(p::inRunOrder({a, row("p", {"q.out"}, {"p.out"}), row("q", {"p.out"}, {"q.out"})}), articula::ProcessingError);
+  EXPECT_THROW(p::inRunOrder({a, a}), articula::ProcessingError);
+  // The pipeline's own stages, as listed.
+  EXPECT_EQ(names(p::inRunOrder(p::pipelineStages())),
+            (std::vector<std::string>{"segment", "mesh", "sample", "fit", "errors", "report"}));
+}

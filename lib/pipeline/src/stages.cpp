@@ -19,9 +19,8 @@ std::vector<StageDescription (*)()>& registeredStages() {
   return list;
 }
 
-// The stages in an order that runs every stage after those that write its
-// inputs: of the stages ready to run, the one listed first (the pipeline's
-// own in their order, then those registered, by name).
+}  // namespace
+
 std::vector<StageDescription> inRunOrder(std::vector<StageDescription> listed) {
   std::map<std::string, size_t> writer;
   for (size_t i = 0; i < listed.size(); ++i) {
@@ -54,8 +53,6 @@ std::vector<StageDescription> inRunOrder(std::vector<StageDescription> listed) {
   }
   return ordered;
 }
-
-}  // namespace
 
 bool registerStage(StageDescription (*describe)()) {
   registeredStages().push_back(describe);

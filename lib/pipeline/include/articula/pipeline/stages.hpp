@@ -47,11 +47,16 @@ struct StageDescription {
 std::vector<std::string> expandArguments(const StageDescription& stage, const std::string& ct, const std::string& folder,
                                          const std::string& joint, const std::string& side);
 
-/// Every stage in run order: each after the stages that write its inputs
-/// (segment, mesh, sample, fit, errors, report, and those registered). A
-/// file two stages write, an input no stage writes or a cycle is refused
-/// (ProcessingError).
+/// Every stage in run order (inRunOrder of the pipeline's own, then those
+/// registered, by name): segment, mesh, sample, fit, errors, report, and
+/// those registered where their inputs place them.
 const std::vector<StageDescription>& stages();
+
+/// `listed` in an order that runs each stage after those that write its
+/// inputs: of the stages ready to run, the one listed first. Throws
+/// ProcessingError for a file two stages write, an input ("CT" aside) no
+/// stage writes, two stages of one name, or a cycle.
+std::vector<StageDescription> inRunOrder(std::vector<StageDescription> listed);
 
 /// The pipeline's own stages, in their order.
 std::vector<StageDescription> pipelineStages();
