@@ -27,11 +27,6 @@ fs::path scratch(const std::string& name) {
   return articula::testsupport::scratchDir(name);
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 TEST(AtomicFile, AnUncommittedWriteLeavesNothing) {
   const fs::path dir = scratch("uncommitted");
   {
@@ -42,9 +37,9 @@ TEST(AtomicFile, AnUncommittedWriteLeavesNothing) {
   }  // destroyed without commit, as when an exception unwinds
   EXPECT_TRUE(fs::is_empty(dir));
   writeFileAtomically(dir / "out.json", "whole\n");
-  EXPECT_EQ(slurp(dir / "out.json"), "whole\n");
+  EXPECT_EQ(articula::testsupport::readText(dir / "out.json"), "whole\n");
   EXPECT_THROW(writeFileAtomically(dir / "out.json", "again\n", false), UsageError);
-  EXPECT_EQ(slurp(dir / "out.json"), "whole\n");
+  EXPECT_EQ(articula::testsupport::readText(dir / "out.json"), "whole\n");
 }
 
 TEST(AtomicFile, TemporariesKeepTheExtensionAndAreHidden) {
@@ -88,7 +83,7 @@ TEST(OutputLock, ASecondHolderIsRefusedNamingTheFirst) {
   {
     OutputLock first(dir, "articula run");
     EXPECT_TRUE(fs::exists(dir / ".articula" / "lock"));
-    EXPECT_NE(slurp(dir / ".articula" / "lock").find("(pid " + std::to_string(::getpid()) + ")"), std::string::npos);
+    EXPECT_NE(articula::testsupport::readText(dir / ".articula" / "lock").find("(pid " + std::to_string(::getpid()) + ")"), std::string::npos);
     // Another open file description, as another process has: refused.
     try {
       OutputLock second(dir, "articula run");
@@ -109,7 +104,7 @@ TEST(OutputLock, AKilledHolderLeavesNoLock) {
     ::pause();
     ::_exit(0);
   }
-  for (int i = 0; i < 500 && slurp(dir / ".articula" / "lock").empty(); ++i) ::usleep(2000);
+  for (int i = 0; i < 500 && articula::testsupport::readText(dir / ".articula" / "lock").empty(); ++i) ::usleep(2000);
   EXPECT_THROW(OutputLock(dir, "parent"), ProcessingError);
   ::kill(child, SIGKILL);
   int status = 0;

@@ -139,8 +139,7 @@ TEST(ImagingIo, DamagedGzipStreamIsRefusedWithZlibsReason) {
   unsigned state = 12345;  // noise, so that the stream stays long
   for (float& x : v.voxels) x = static_cast<float>((state = state * 1103515245u + 12345u) >> 20) - 2048.0f;
   imaging::writeVolume(dir / "whole.nii.gz", v);
-  std::ifstream in(dir / "whole.nii.gz", std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = testsupport::readText(dir / "whole.nii.gz");
   ASSERT_GT(bytes.size(), 4000u);
   std::ofstream(dir / "cut.nii.gz", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   try {

@@ -138,8 +138,7 @@ TEST(Mesh, PointValuesAreActiveScalarsOfAVtpCloud) {
   mesh::writePointValues(dir / "p.vtp", points, "signed_distance_mm", d);
   const points::PointCloud back = points::readPoints(dir / "p.vtp");
   EXPECT_LT((back.positions - points).cwiseAbs().maxCoeff(), 1e-5);
-  std::ifstream in(dir / "p.vtp", std::ios::binary);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = testsupport::readText(dir / "p.vtp");
   EXPECT_NE(text.find("Scalars=\"signed_distance_mm\""), std::string::npos) << text.substr(0, 400);
   EXPECT_NE(text.find("Name=\"SPACE\""), std::string::npos);
   EXPECT_THROW(mesh::writePointValues(dir / "p.ply", points, "d", d), UsageError);

@@ -111,14 +111,12 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
   const fs::path mesh_summary = folder / "bone.vtp.json";
   if (fs::exists(mesh_summary)) {
     const json mesh = readStageJson(mesh_summary);
-    if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("moved") &&
-        mesh.at("ct_edges").at("moved").is_boolean())
-      in.surface_on_ct_edges = mesh.at("ct_edges").at("moved").get<bool>();
+    const json edges = mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() ? mesh.at("ct_edges") : json::object();
+    if (edges.contains("moved") && edges.at("moved").is_boolean()) in.surface_on_ct_edges = edges.at("moved").get<bool>();
     // The edges' model fallen back to the steepest falls (no point-spread
     // estimated): a named check, not the mesh stage's terminal line only.
-    if (mesh.contains("ct_edges") && mesh.at("ct_edges").is_object() && mesh.at("ct_edges").contains("cortex_model_note") &&
-        mesh.at("ct_edges").at("cortex_model_note").is_string())
-      in.stage_warnings.push_back("mesh: " + mesh.at("ct_edges").at("cortex_model_note").get<std::string>());
+    if (edges.contains("cortex_model_note") && edges.at("cortex_model_note").is_string())
+      in.stage_warnings.push_back("mesh: " + edges.at("cortex_model_note").get<std::string>());
   }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
@@ -225,12 +223,10 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
   json models = json::array();
   std::vector<std::string> csv_header = {"model", "n_parameters", "aic", "bic", "least_rms"};
   std::string csv_rows;
-  geometry::ShapeParameters best_shape = shapes.front();
   for (size_t model_index = 0; model_index < shapes.size(); ++model_index) {
     const geometry::ShapeParameters& shape = shapes[model_index];
     const json& fit_entry = fits.at("models")[model_index];
     const std::string name = geometry::modelName(shape.model);
-    if (name == best) best_shape = shape;
     const auto names = geometry::parameterNames(shape.model);
     const auto kinds = geometry::parameterKinds(shape.model);
     const Eigen::VectorXd lambda = geometry::toVector(shape);
@@ -340,7 +336,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
   // The head centre and axes of the selected model (one the points
   // determine, unlike the least-RMS model at times), for 3D Slicer and
   // results.json.
-  geometry::ShapeParameters selected_shape = best_shape;
+  geometry::ShapeParameters selected_shape = shapes.front();  // the selection names one of them
   for (const auto& shape : shapes)
     if (geometry::modelName(shape.model) == selection.selected) selected_shape = shape;
   const Eigen::Matrix3d R = geometry::rotationFromAngles(selected_shape.angles);

@@ -31,8 +31,9 @@ inline std::filesystem::path scratchDir(const std::string& name) {
 
 inline void writeText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
+/// The whole file, byte for byte.
 inline std::string readText(const std::filesystem::path& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
