@@ -14,6 +14,7 @@
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/fits_csv.hpp"
 #include "articula/fit/fits_json.hpp"
+#include "articula/imaging/io.hpp"
 #include "articula/pipeline/stage_options_cli.hpp"
 #include "articula/points/point_io.hpp"
 
@@ -46,6 +47,9 @@ class FitCommand : public cli::Command {
     app.add_option("-i,--input", input_, "Points (.ply, .csv/.xyz/.txt, or the vertices of .stl/.obj/.vtp), LPS mm")
         ->required();
     app.add_option("-o,--output", output_, "fits.json (fits.csv is written beside it)")->required();
+    app.add_option("--grid", grid_,
+                   "The image the points were found in (the CT or its label, .nii.gz/.nrrd/.mha): its voxels size the "
+                   "edge offset over the surface that the intervals add (without: the residuals' part alone)");
     pipeline::addStageOptions(app, name(), settings_);
   }
 
@@ -61,10 +65,14 @@ class FitCommand : public cli::Command {
     o.sample_points = given.sample_points;
     o.seed = static_cast<unsigned>(common.seed);
     if (!given.bounds.empty()) o.bounds = readBounds(given.bounds);
+    if (!grid_.empty()) {
+      const imaging::ImageGeometry grid = imaging::readImageGeometry(grid_);
+      o.edge_offset = fit::edgeOffsetField(grid.spacing, grid.direction.col(2));
+    }
     o.validate();
     if (output_.extension() != ".json") throw UsageError("--output: expected a .json file, found '" + output_.string() + "'");
     const std::filesystem::path csv = std::filesystem::path(output_).replace_extension(".csv");
-    refuseOutputsOverInputs({output_, csv}, {input_, given.bounds});
+    refuseOutputsOverInputs({output_, csv}, {input_, given.bounds, grid_});
     checkOutputTarget(output_);
     cli::refuseExistingOutputs({output_, csv}, common.force);
 
@@ -81,6 +89,7 @@ class FitCommand : public cli::Command {
                              {"max_evaluations", given.max_evaluations}, {"sample_points", given.sample_points}, {"bounds", nlohmann::json(o.bounds)}};
     std::vector<std::filesystem::path> inputs = {input_};
     if (!given.bounds.empty()) inputs.push_back(given.bounds);
+    if (!grid_.empty()) inputs.push_back(grid_);
     const nlohmann::json doc = fit::fitsDocument(summary, input_.string(), given.objective,
                                                  provenanceJson({params, inputs, common.seed}));
     writeFileAtomically(output_, doc.dump(2) + "\n", common.force);
@@ -92,7 +101,7 @@ class FitCommand : public cli::Command {
   }
 
  private:
-  std::filesystem::path input_, output_;
+  std::filesystem::path input_, output_, grid_;
   pipeline::StageSettings settings_;
 };
 

@@ -92,7 +92,10 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d semi = semiAxes(shape);
         const bool ovoid = shape.model == ShapeModel::Ovoid || shape.model == ShapeModel::Superovoid;
         for (auto method : methods) {
-          const auto u = articula::fit::parameterUncertainty(shape, points, {}, method);
+          articula::fit::EdgeOffsetField field;
+          if (c.contains("spacing_mm"))
+            field = articula::fit::edgeOffsetField(vec3(c.at("spacing_mm")), vec3(c.at("slice_axis")));
+          const auto u = articula::fit::parameterUncertainty(shape, points, {}, method, field);
           const auto names = articula::geometry::parameterNames(shape.model);
           auto se_of = [&](const std::string& name) {
             const auto at = std::find(names.begin(), names.end(), name);
@@ -122,6 +125,7 @@ int main(int argc, char** argv) {
                                       {"model", articula::geometry::modelName(shape.model)},
                                       {"method", u.method},
                                       {"offset_mm", offset},
+                                      {"edge_offset_sd_mm", {field.linear_sd_mm, field.across_slices_sd_mm}},
                                       {"centre_z", centre},
                                       {"radius_z", radius},
                                       {"radius_less_offset_z", radius_offset},

@@ -53,7 +53,8 @@ def third_cases(work):
         A = h["axes_lps_columns"]  # rows of this list are the matrix's rows
         columns = [[A[r][c] for r in range(3)] for c in range(3)]
         model = "sphere" if max(h["radii_mm"]) - min(h["radii_mm"]) < 1e-9 else "ellipsoid"
-        yield dict(id=f"{name}-{side}", set="third", run=run,
+        D = t.get("direction_lps", [[1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        yield dict(id=f"{name}-{side}", set="third", run=run, slice_axis=[D[r][2] for r in range(3)],
                    truth=dict(model=model, center_mm=h["head_center_mm"], radii_mm=h["radii_mm"], axes_columns=columns))
 
 
@@ -72,6 +73,9 @@ def main():
             cases += list(make(work))
     for c in cases:
         c["points"], c["fits"] = f"{c['run']}/points.ply", f"{c['run']}/fits.json"
+        sp = json.load(open(f"{c['run']}/label.nii.gz.json")).get("spacing_mm")
+        if sp:
+            c["spacing_mm"], c["slice_axis"] = sp, c.get("slice_axis", [0, 0, 1])
     with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
         json.dump(cases, f)
     methods = [m for m in a.methods.split(",") if m]

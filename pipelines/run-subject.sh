@@ -14,7 +14,7 @@ mkdir -p "$out"
 "$bin/articula-segment" -i "$input" -o "$out/label.nii.gz" --joint "$joint" --side "$side" --force
 "$bin/articula-mesh"    -i "$out/label.nii.gz" -o "$out/bone.vtp" --ct "$input" --force
 "$bin/articula-sample"  -i "$out/bone.vtp" -o "$out/points.ply" --force
-"$bin/articula-fit"     -i "$out/points.ply" -o "$out/fits.json" --force
+"$bin/articula-fit"     -i "$out/points.ply" -o "$out/fits.json" --grid "$out/label.nii.gz" --force
 "$bin/articula-errors"  -i "$out/points.ply" --fits "$out/fits.json" -o "$out/errors" --force
 "$bin/articula-report"  -i "$out" --ct "$input" --joint "$joint" --side "$side" --force
 echo "done: $out/results.json"

@@ -30,6 +30,29 @@ rms() { csv_value "$tmp/fits.csv" "$1" rms_mm; }
 le() { awk -v a="$(rms "$1")" -v b="$(rms "$2")" 'BEGIN{exit !(a <= b + 1e-9)}' || fail "rms $1 > rms $2"; }
 le ellipsoid sphere; le superellipsoid ellipsoid; le ovoid ellipsoid; le superovoid superellipsoid; le superovoid ovoid
 
+# --grid: the voxels the points came from size the edge offset's part of the
+# intervals (a 4 x 4 x 4 NRRD header of 1 x 1 x 3 mm voxels, slices along S):
+# the linear field moves the centre by 0.01 h^2 = 0.09 mm for h = 3 mm.
+printf 'NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 4 4\nspace directions: (1,0,0) (0,1,0) (0,0,3)\nkinds: domain domain domain\nencoding: raw\nspace origin: (0,0,0)\n\n' > "$tmp/grid.nrrd"
+head -c 64 /dev/zero >> "$tmp/grid.nrrd"
+expect_rc 0 "$bin/articula-fit" -i "$tmp/so.ply" -o "$tmp/gridded.json" --grid "$tmp/grid.nrrd" --models sphere,ellipsoid -q
+python3 - "$tmp/fits.json" "$tmp/gridded.json" <<'PY' || fail "--grid: the edge offset field and its part of the intervals"
+import json, sys
+plain, gridded = (json.load(open(p)) for p in sys.argv[1:])
+field = gridded["edge_offset_field"]
+assert plain["edge_offset_field"] is None, plain["edge_offset_field"]
+assert field["voxel_spacing_mm"] == [1, 1, 3] and field["slice_axis_lps"] == [0, 0, 1], field
+assert abs(field["linear_sd_mm"] - 0.09) < 1e-9 and field["across_slices_sd_mm"] > 0.2, field
+sphere = lambda d: next(m for m in d["models"] if m["model"] == "sphere")
+part = sphere(gridded)["edge_offset_standard_errors_table_3_2"]
+for t in ("t1", "t2", "t3"):
+    assert abs(part[t] - 0.09) < 0.01, (t, part[t])
+    assert sphere(gridded)["standard_errors_table_3_2"][t] > sphere(plain)["standard_errors_table_3_2"][t], t
+PY
+echo "not an image" > "$tmp/grid.txt"
+expect_rc 3 "$bin/articula-fit" -i "$tmp/so.ply" -o "$tmp/x.json" --grid "$tmp/grid.txt"
+grep -q "grid.txt" "$tmp/err" || fail "a bad --grid named"
+
 # Deterministic for a seed (the global-local strategy uses NLopt's random numbers).
 expect_rc 0 "$bin/articula-fit" -i "$tmp/so.ply" -o "$tmp/g1.json" --seed 3 --strategy global-local --models sphere,ellipsoid
 expect_rc 0 "$bin/articula-fit" -i "$tmp/so.ply" -o "$tmp/g2.json" --seed 3 --strategy global-local --models sphere,ellipsoid

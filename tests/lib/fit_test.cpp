@@ -455,6 +455,59 @@ TEST(ParameterUncertainty, TheOvoidsScaleIsAGaugeHeldWhileItsShapeIsDetermined) 
   EXPECT_GT(s.uncertainty.standard_error[0], 3 * s.uncertainty.independent_standard_error[0]);
 }
 
+// The edge offset field's part of the intervals against the shift the field
+// itself causes: an exact ellipsoid cap (1,500 points, 80 degrees) whose
+// points are moved along their normals by sd (f - mean f) for each of the
+// field's terms (n_x, n_y, n_z, (n . s)^2 for an oblique slice axis s),
+// refitted. To first order each term moves the estimate by bread J^T f sd,
+// so the part reported for a radius or centre coordinate is the root sum of
+// squares of those refits' shifts (within 5 %, the fit's nonlinearity at a
+// 0.05 mm field). A part off by the field's mean (the shared offset) or
+// missing a term would miss by far more.
+TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
+  const ShapeParameters truth = trueShape(ShapeModel::Ellipsoid);
+  const Eigen::MatrixX3d cap = articula::fit::syntheticCap(truth, 80.0 * M_PI / 180.0, 1500, 0.0, 4);
+  const auto surface = articula::geometry::makeSurface(truth);
+  Eigen::MatrixX3d normals(cap.rows(), 3);
+  for (Eigen::Index i = 0; i < cap.rows(); ++i)
+    normals.row(i) = surface->gradient(cap.row(i).transpose()).normalized().transpose();
+  const Eigen::Vector3d slice_axis = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  articula::fit::EdgeOffsetField field;
+  field.slice_axis = slice_axis;
+  field.linear_sd_mm = 0.05;
+  field.across_slices_sd_mm = 0.05;
+  Options o;
+  o.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid};
+  // Shifts of the three radii (along the true axes) and the centre.
+  Eigen::VectorXd expected_square = Eigen::VectorXd::Zero(6);
+  for (int term = 0; term < 4; ++term) {
+    Eigen::VectorXd f = term < 3 ? Eigen::VectorXd(normals.col(term)) : Eigen::VectorXd((normals * slice_axis).array().square());
+    f.array() -= f.mean();
+    const Eigen::MatrixX3d moved = cap + (0.05 * f).asDiagonal() * normals;
+    const ShapeParameters p = articula::fit::fitHierarchy(moved, o).fit(ShapeModel::Ellipsoid).parameters;
+    const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(p.angles);
+    const Eigen::Matrix3d Rt = articula::geometry::rotationFromAngles(truth.angles);
+    for (int i = 0; i < 3; ++i) {
+      expected_square[i] += std::pow(p.radii[fittedAxisAlong(Rf, Rt.col(i))] - truth.radii[i], 2);
+      expected_square[3 + i] += std::pow(p.center[i] - truth.center[i], 2);
+    }
+  }
+  const articula::fit::ParameterUncertainty u =
+      articula::fit::parameterUncertainty(truth, cap, {}, articula::fit::UncertaintyMethod::SpatialModel, field);
+  for (int k = 0; k < 6; ++k) {
+    const double expected = std::sqrt(expected_square[k]);
+    EXPECT_GT(expected, 0.005) << k;  // the field moves every one of them
+    EXPECT_NEAR(u.systematic_standard_error[k], expected, 0.05 * expected) << k;
+  }
+  // Sized from the voxels: none of the slices' term beyond its base for
+  // isotropic 0.5 mm voxels, both larger at 1 x 1 x 3 mm.
+  const auto fine = articula::fit::edgeOffsetField(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d::UnitZ());
+  const auto coarse = articula::fit::edgeOffsetField(Eigen::Vector3d(1.0, 1.0, 3.0), Eigen::Vector3d::UnitZ());
+  EXPECT_LT(fine.linear_sd_mm, 0.005);
+  EXPECT_GT(coarse.linear_sd_mm, 10 * fine.linear_sd_mm);
+  EXPECT_GT(coarse.across_slices_sd_mm, 5 * fine.across_slices_sd_mm);
+}
+
 namespace {
 
 // The correlation of the exponential field itself, summed over every pair:

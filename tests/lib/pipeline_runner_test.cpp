@@ -84,8 +84,10 @@ TEST_F(Runner, PlansEachStageWithItsFilesAndOnlyItsOptions) {
   EXPECT_EQ(plans[0].arguments, (Names{"-i", "/data/ct.nii.gz", "-o", "/out/s1/label.nii.gz", "--joint", "shoulder",
                                        "--side", "left", "--seed", "7", "--threads", "3", "--force", "--verbose"}));
   EXPECT_EQ(plans[1].inputs, (std::vector<fs::path>{"/out/s1/label.nii.gz", "/data/ct.nii.gz"}));
-  EXPECT_EQ(plans[3].arguments, (Names{"-i", "/out/s1/points.ply", "-o", "/out/s1/fits.json", "--models",
-                                       "sphere,ellipsoid", "--seed", "7", "--threads", "3", "--force", "--verbose"}));
+  EXPECT_EQ(plans[3].arguments,
+            (Names{"-i", "/out/s1/points.ply", "-o", "/out/s1/fits.json", "--grid", "/out/s1/label.nii.gz", "--models",
+                   "sphere,ellipsoid", "--seed", "7", "--threads", "3", "--force", "--verbose"}));
+  EXPECT_EQ(plans[3].inputs, (std::vector<fs::path>{"/out/s1/points.ply", "/out/s1/label.nii.gz"}));
   EXPECT_EQ(plans[3].outputs, (std::vector<fs::path>{"/out/s1/fits.json", "/out/s1/fits.csv"}));
   EXPECT_EQ(pipeline::argumentsProblem(run), "");
 

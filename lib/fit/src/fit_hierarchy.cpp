@@ -888,7 +888,7 @@ ModelFit fitFrom(const ShapeParameters& start, const Eigen::MatrixX3d& points, c
   const AlgebraicStarts a = algebraicStarts(points);
   const Bounds b = makeBounds(start.model, a.ellipsoid, a.sphere, o);
   Fitted f = fitModel(start.model, {{"given start", start, {}}}, b, points, o);
-  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty);
+  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty, o.edge_offset);
   return f.fit;
 }
 
@@ -931,7 +931,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   for (const Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid})
     if (wanted(o, f->fit.parameters.model) && f->fit.evaluations > 0) {
       summary.fits.push_back(f->fit);
-      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty);
+      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty, o.edge_offset);
     }
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)

@@ -44,12 +44,15 @@ nlohmann::json modelFitJson(const ModelFit& f) {
   for (size_t i = 0; i < names.size(); ++i) parameters[names[i]] = lambda[static_cast<Eigen::Index>(i)];
   // Standard errors and 95 % intervals (null: not identifiable from these points).
   const ParameterUncertainty& u = f.uncertainty;
-  nlohmann::json errors = nlohmann::json::object(), intervals = nlohmann::json::object();
+  nlohmann::json errors = nlohmann::json::object(), intervals = nlohmann::json::object(),
+                 systematic = nlohmann::json::object();
   const auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   if (u.standard_error.size() == static_cast<Eigen::Index>(names.size()))
     for (size_t i = 0; i < names.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
       errors[names[i]] = finite(u.standard_error[k]);
+      if (u.systematic_standard_error.size() == u.standard_error.size())
+        systematic[names[i]] = std::isfinite(u.standard_error[k]) ? nlohmann::json(u.systematic_standard_error[k]) : nlohmann::json(nullptr);
       intervals[names[i]] = std::isfinite(u.standard_error[k]) ? nlohmann::json{u.ci95_lower[k], u.ci95_upper[k]} : nlohmann::json(nullptr);
     }
   return {{"model", geometry::modelName(p.model)},
@@ -64,6 +67,7 @@ nlohmann::json modelFitJson(const ModelFit& f) {
           {"parameters_table_3_2", parameters},
           {"standard_errors_table_3_2", errors},
           {"ci95_table_3_2", intervals},
+          {"edge_offset_standard_errors_table_3_2", systematic},
           {"not_identifiable", u.not_identifiable},
           {"gauge", u.gauge},
           {"uncertainty_method", u.method},
@@ -144,12 +148,22 @@ nlohmann::json fitsDocument(const Summary& summary, const std::string& input, co
                             const nlohmann::json& provenance) {
   nlohmann::json models = nlohmann::json::array();
   for (const auto& f : summary.fits) models.push_back(modelFitJson(f));
+  // The edge offset field in every model's intervals (the same for all).
+  nlohmann::json field = nullptr;
+  if (!summary.fits.empty() && summary.fits.front().uncertainty.edge_offset.active()) {
+    const EdgeOffsetField& e = summary.fits.front().uncertainty.edge_offset;
+    field = {{"voxel_spacing_mm", list(e.spacing_mm)},
+             {"slice_axis_lps", list(e.slice_axis)},
+             {"linear_sd_mm", e.linear_sd_mm},
+             {"across_slices_sd_mm", e.across_slices_sd_mm}};
+  }
   return {{"coordinate_system", "LPS"},
           {"units", "mm"},
           {"input", input},
           {"n_points", summary.points},
           {"objective", objective},
           {"least_rms_model", summary.best_model},
+          {"edge_offset_field", field},
           {"seconds", summary.seconds},
           {"models", models},
           {"provenance", provenance}};

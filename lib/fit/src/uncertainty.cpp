@@ -20,6 +20,15 @@ using geometry::ShapeModel;
 // strongest carries no information (double precision leaves ~1e-16 of it).
 constexpr double kRelativeSingularValue = 1e-10;
 
+// edgeOffsetField's sizes, from the phantom benches of three generators
+// (docs/benchmarks.md, "Intervals with correlated residuals"): the linear
+// field's standard deviation kLinearPerMm2 h^2 for the largest voxel side h
+// (a head's centre moved by 0.01-0.05 mm at 1 x 1 x 2 mm, towards its neck);
+// the across-slice field's kAcrossBaseMm + kAcrossPerMm4 s^4 for slices of s
+// (the surface's offset across slices less that within them: 0.02-0.06 mm up
+// to 2 mm slices, 0.11-0.17 mm at 3 mm).
+constexpr double kLinearPerMm2 = 0.01, kAcrossBaseMm = 0.03, kAcrossPerMm4 = 0.0025;
+
 /// Half-widths beyond which an interval says nothing about the head: a
 /// radius or position known to only +-10 mm, an angle to +-45 degrees, an
 /// exponent to +-1, an ovoid coefficient to +-0.5.
@@ -80,6 +89,15 @@ Eigen::MatrixXd meat(UncertaintyMethod method, const Eigen::MatrixX3d& points, c
 
 }  // namespace
 
+EdgeOffsetField edgeOffsetField(const Eigen::Vector3d& spacing_mm, const Eigen::Vector3d& slice_axis) {
+  EdgeOffsetField f;
+  f.slice_axis = (slice_axis.normalized().array() + 0.0).matrix();  // no -0 in fits.json
+  f.spacing_mm = spacing_mm;
+  f.linear_sd_mm = kLinearPerMm2 * spacing_mm.maxCoeff() * spacing_mm.maxCoeff();
+  f.across_slices_sd_mm = kAcrossBaseMm + kAcrossPerMm4 * std::pow(spacing_mm[2], 4);
+  return f;
+}
+
 std::string uncertaintyMethodName(UncertaintyMethod m) {
   switch (m) {
     case UncertaintyMethod::SpatialModel: return "spatial-model";
@@ -99,7 +117,8 @@ UncertaintyMethod uncertaintyMethodFromName(const std::string& name) {
 }
 
 ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points,
-                                          const Eigen::MatrixX3d& closest, UncertaintyMethod method) {
+                                          const Eigen::MatrixX3d& closest, UncertaintyMethod method,
+                                          const EdgeOffsetField& edge_offset) {
   const auto names = geometry::parameterNames(fitted.model);
   const auto kinds = geometry::parameterKinds(fitted.model);
   const Eigen::Index n = points.rows(), m = static_cast<Eigen::Index>(names.size());
@@ -131,6 +150,19 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
   parameterGradient(shape, feet, full, gradient_norms);
   // The derivatives of the signed distances (envelope theorem, parameter_gradient.hpp).
   for (Eigen::Index i = 0; i < n; ++i) full.row(i) /= std::max(gradient_norms[i], 1e-300);
+  // The edge offset's fields n_x, n_y, n_z, (n . s)^2, each less its mean
+  // and times its standard deviation; n, the fitted surface's normal at each
+  // foot, is minus the distances' derivatives along t1..t3.
+  Eigen::MatrixX4d fields;
+  if (edge_offset.active()) {
+    const auto t = std::find(names.begin(), names.end(), "t1") - names.begin();
+    fields.resize(n, 4);
+    fields.leftCols(3) = -full.middleCols(t, 3);
+    fields.col(3) = (fields.leftCols(3) * edge_offset.slice_axis).array().square().matrix();
+    fields.rowwise() -= fields.colwise().mean();
+    fields.leftCols(3) *= edge_offset.linear_sd_mm;
+    fields.col(3) *= edge_offset.across_slices_sd_mm;
+  }
   std::vector<Eigen::Index> active;
   for (Eigen::Index j = 0; j < m; ++j)
     if (!held[static_cast<size_t>(j)]) active.push_back(j);
@@ -162,6 +194,8 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
     middle = meat(method, points, J, residual, out.correlation);
   }
 
+  // J^T f before the QR below overwrites J.
+  const Eigen::MatrixXd field_scores = edge_offset.active() ? Eigen::MatrixXd(J.transpose() * fields) : Eigen::MatrixXd();
   // J = QR and R share their singular values and right singular vectors: the
   // SVD of the small R, after a QR in place, keeps the memory of one J
   // (120 MB at 10^6 points) where an SVD of J would hold three.
@@ -191,12 +225,21 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
     const double level = trace > 0 ? sse / std::max(trace - absorbed, 0.1 * trace) : 0.0;
     middle *= level;
   }
-  const Eigen::MatrixXd covariance = bread * middle * bread;
+  Eigen::MatrixXd covariance = bread * middle * bread;
+  // A field f moves the estimate by bread J^T f.
+  Eigen::MatrixXd systematic = Eigen::MatrixXd::Zero(k, k);
+  if (edge_offset.active()) {
+    const Eigen::MatrixXd shifts = bread * field_scores;
+    systematic = shifts * shifts.transpose();
+    covariance += systematic;
+  }
+  out.edge_offset = edge_offset;
   const double s2 = sse / static_cast<double>(n - k);
 
   const Eigen::VectorXd estimate = geometry::toVector(fitted);
   out.standard_error = Eigen::VectorXd::Constant(m, std::numeric_limits<double>::infinity());
   out.independent_standard_error = out.standard_error;
+  out.systematic_standard_error = Eigen::VectorXd::Zero(m);
   out.ci95_lower = Eigen::VectorXd::Constant(m, -std::numeric_limits<double>::infinity());
   out.ci95_upper = Eigen::VectorXd::Constant(m, std::numeric_limits<double>::infinity());
   for (Eigen::Index j = 0; j < m; ++j)
@@ -212,6 +255,7 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
                                   : std::sqrt(std::max(covariance(a, a), 0.0)) / scale[a];
     const double se = canonical * to_raw[j];
     out.standard_error[j] = se;
+    out.systematic_standard_error[j] = free ? 0.0 : std::sqrt(std::max(systematic(a, a), 0.0)) / scale[a] * to_raw[j];
     out.independent_standard_error[j] = free ? se : std::sqrt(s2 * bread(a, a)) / scale[a] * to_raw[j];
     out.ci95_lower[j] = estimate[j] - 1.96 * se;
     out.ci95_upper[j] = estimate[j] + 1.96 * se;

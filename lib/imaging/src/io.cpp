@@ -618,6 +618,31 @@ Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, Re
 
 }  // namespace
 
+ImageGeometry readImageGeometry(const fs::path& input) {
+  if (!fs::is_regular_file(input)) throw InputError("image not found: " + input.string());
+  const itk::ImageIOBase::Pointer io = imageIoFor(input);
+  if (!io) throw InputError("expected an image (.nii.gz/.nii/.nrrd/.mha), found " + input.string());
+  try {
+    io->SetFileName(input.string());
+    io->ReadImageInformation();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("could not read the image header of " + input.string() + ": " + e.GetDescription());
+  }
+  if (io->GetNumberOfDimensions() != 3)
+    throw InputError("expected a 3-D image, found " + std::to_string(io->GetNumberOfDimensions()) + " dimensions in " +
+                     input.string());
+  ImageGeometry g;
+  for (unsigned a = 0; a < 3; ++a) {
+    g.size[a] = static_cast<int>(io->GetDimensions(a));
+    g.spacing[a] = io->GetSpacing(a);
+    g.origin[a] = io->GetOrigin(a);
+    const std::vector<double> column = io->GetDirection(a);
+    for (unsigned r = 0; r < 3; ++r) g.direction(r, a) = column[r];
+  }
+  checkDirection(g.direction, input.string());
+  return g;
+}
+
 Label readLabel(const fs::path& input) {
   if (!fs::is_regular_file(input)) throw InputError("label image not found: " + input.string());
   if (!isImageFile(input)) throw InputError("expected a label image (.nii.gz/.nrrd/.mha), found " + input.string());

@@ -105,9 +105,10 @@ std::vector<StageDescription> pipelineStages() {
       {"fit",
        "The shape-model hierarchy fitted to the points",
        stageOptions("fit"),
-       {"points.ply"},
+       {"points.ply", "label.nii.gz"},
        {"fits.json", "fits.csv"},
-       {"-i", "{folder}/points.ply", "-o", "{folder}/fits.json"},
+       // The label for its voxel grid, which sizes the intervals' edge offset.
+       {"-i", "{folder}/points.ply", "-o", "{folder}/fits.json", "--grid", "{folder}/label.nii.gz"},
        {},
        2, 1000},
       {"errors",

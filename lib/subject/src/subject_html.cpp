@@ -133,8 +133,12 @@ std::string verdictSection(const json& results) {
   if (correlation.is_object())
     note += " (" + fixed(numberAt(correlation, "n_eff"), 0) + " effective independent points of " +
             fixed(numberAt(correlation, "n_points"), 0) + ")";
+  if (results.contains("edge_offset_field") && results.at("edge_offset_field").is_object())
+    note += ", and an edge offset varying over the surface, sized from the CT's voxels (standard deviations " +
+            fixed(numberAt(results.at("edge_offset_field"), "linear_sd_mm"), 3) + " mm for a tilt, " +
+            fixed(numberAt(results.at("edge_offset_field"), "across_slices_sd_mm"), 3) + " mm across the slices)";
   note += ". It does not hold a shift of the whole surface shared by every point (an edge found outside a thin "
-          "cortex), nor one that depends on the surface's direction to the slices: the radii carry them.";
+          "cortex): the radii carry it.";
   return html + "</table>\n<p class=\"note\">" + note + "</p></section>\n";
 }
 

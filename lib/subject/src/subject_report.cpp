@@ -246,15 +246,21 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
     entry["semi_axes_mm"] = {semi[0], semi[1], semi[2]};
     // Standard errors in the parameters' units (angles in degrees); null:
     // not identifiable from these points (fits.json, fit/uncertainty.hpp).
-    if (fit_entry.contains("standard_errors_table_3_2")) {
-      json standard_errors = json::object();
-      const json& se = fit_entry.at("standard_errors_table_3_2");
+    const auto inUnits = [&](const json& se) {
+      json out = json::object();
       for (size_t i = 0; i < names.size(); ++i) {
         json v = se.value(names[i], json(nullptr));
         if (v.is_number() && kinds[i] == geometry::ParameterKind::Angle) v = v.get<double>() * 180.0 / M_PI;
-        standard_errors[withUnit(names[i], kinds[i])] = v;
+        out[withUnit(names[i], kinds[i])] = v;
       }
-      entry["standard_errors"] = standard_errors;
+      return out;
+    };
+    if (fit_entry.contains("standard_errors_table_3_2")) {
+      const json& se = fit_entry.at("standard_errors_table_3_2");
+      entry["standard_errors"] = inUnits(se);
+      // Their part from the edge offset over the surface (fits.json's edge_offset_field).
+      if (fit_entry.contains("edge_offset_standard_errors_table_3_2"))
+        entry["edge_offset_standard_errors"] = inUnits(fit_entry.at("edge_offset_standard_errors_table_3_2"));
       entry["not_identifiable"] = fit_entry.value("not_identifiable", json::array());
       entry["gauge"] = fit_entry.value("gauge", json::array());
       // The semi-axes' standard errors: an ovoid's a c0x and b c0y with c0 held.
@@ -385,6 +391,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"side", o.side},
       {"selected_model", selection.selected},
       {"least_rms_model", best},
+      {"edge_offset_field", fits.value("edge_offset_field", json(nullptr))},
       {"selection",
        {{"rule",
          "each model the points determine (not undetermined) is tested against every determined model containing it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "

@@ -70,6 +70,9 @@ struct Options {
   /// Overrides by parameter name of table 3.2 ("a", "gamma1", "c2x", "t1", ...).
   std::map<std::string, std::pair<double, double>> bounds;
   UncertaintyMethod uncertainty = UncertaintyMethod::SpatialModel;  // of every reported model
+  /// The edge's offset field the points' voxel grid implies (none: points of
+  /// unknown origin; their intervals hold what the residuals show).
+  EdgeOffsetField edge_offset;
 
   /// Throws UsageError naming the first bad field.
   void validate() const;

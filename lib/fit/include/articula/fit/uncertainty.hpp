@@ -26,6 +26,16 @@
 // point (a cortex's edge found outside the bone by the same amount
 // everywhere) moves the radii by that offset and is not seen in the
 // residuals; docs/user-guide.md names it.
+//
+// What the residuals cannot show either, but the voxel grid sizes: the
+// edge's offset varies smoothly over the surface (partial volume against a
+// neighbouring bone, a blur the edge model does not match), and across slices
+// thicker than the in-plane voxels it varies with the normal's share across
+// them, (n . s)^2 for the slice axis s. Such fields look like a change of
+// position or shape and the fit absorbs them. EdgeOffsetField gives their
+// size; their effect on the parameters is added to the covariance as a
+// systematic component, each field less its mean over the points (the mean
+// is the shared offset above).
 #include <string>
 #include <vector>
 
@@ -46,11 +56,30 @@ std::string uncertaintyMethodName(UncertaintyMethod m);
 /// "spatial-model", "independent", "spatial-hac", "patch-bootstrap"; throws UsageError otherwise.
 UncertaintyMethod uncertaintyMethodFromName(const std::string& name);
 
+/// A surface offset beta . n + gamma (n . slice_axis)^2 over the surface
+/// normals n, its coefficients shared by the points of one scan: beta with
+/// standard deviation linear_sd_mm in each direction, gamma across_slices_sd_mm.
+struct EdgeOffsetField {
+  Eigen::Vector3d slice_axis = Eigen::Vector3d::UnitZ();  // unit slice normal, LPS
+  Eigen::Vector3d spacing_mm = Eigen::Vector3d::Zero();   // the voxels it was sized for (0: none)
+  double linear_sd_mm = 0;
+  double across_slices_sd_mm = 0;
+  bool active() const { return linear_sd_mm > 0 || across_slices_sd_mm > 0; }
+};
+
+/// The field's size for a CT's voxels (`spacing_mm`: within a slice, within a
+/// slice, across; the last the larger of the slices' spacing and thickness)
+/// and slice axis, set from the phantom benches of three generators
+/// (docs/benchmarks.md).
+EdgeOffsetField edgeOffsetField(const Eigen::Vector3d& spacing_mm, const Eigen::Vector3d& slice_axis);
+
 struct ParameterUncertainty {
   std::string method;                       // uncertaintyMethodName of the method used
   Eigen::VectorXd standard_error;           // table 3.2 order; infinity where not identifiable or a gauge
   Eigen::VectorXd ci95_lower, ci95_upper;   // estimate -+ 1.96 standard errors
   Eigen::VectorXd independent_standard_error;  // what independent residuals would give, for comparison
+  Eigen::VectorXd systematic_standard_error;  // the edge offset field's part of standard_error (0: none)
+  EdgeOffsetField edge_offset;              // the field used
   std::vector<std::string> not_identifiable;  // parameter names: a near-singular J^T J or a very wide interval
   std::vector<std::string> gauge;           // held at their fitted values: an ovoid's c0x and c0y
   double condition_number = 0;              // of J^T J with unit-scaled columns, gauge held
@@ -63,6 +92,7 @@ struct ParameterUncertainty {
 /// Throws InputError when there are no more points than parameters.
 ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points,
                                           const Eigen::MatrixX3d& closest = {},
-                                          UncertaintyMethod method = UncertaintyMethod::SpatialModel);
+                                          UncertaintyMethod method = UncertaintyMethod::SpatialModel,
+                                          const EdgeOffsetField& edge_offset = {});
 
 }  // namespace articula::fit

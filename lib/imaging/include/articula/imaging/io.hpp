@@ -79,6 +79,11 @@ class VolumeMemory {
   Kept* kept_;
 };
 
+/// The voxel grid of an image file (.nii.gz/.nii/.nrrd/.mha) from its header
+/// alone (no voxels read). Throws InputError for another file, a header ITK
+/// cannot read, or an image that is not 3-D with an orthonormal direction.
+ImageGeometry readImageGeometry(const std::filesystem::path& input);
+
 /// Reads a label image (any integer type, non-zero = 1).
 Label readLabel(const std::filesystem::path& input);
 
