@@ -461,8 +461,9 @@ TEST(ParameterUncertainty, TheOvoidsScaleIsAGaugeHeldWhileItsShapeIsDetermined) 
 // field's terms (n_x, n_y, n_z, (n . s)^2 for an oblique slice axis s),
 // refitted. To first order each term moves the estimate by bread J^T f sd,
 // so the part reported for a radius or centre coordinate is the root sum of
-// squares of those refits' shifts (within 5 %, the fit's nonlinearity at a
-// 0.05 mm field). A part off by the field's mean (the shared offset) or
+// squares of those refits' shifts, and the field's sum of squares the model
+// takes up is what the refits remove of it (each within 5 %, the fit's
+// nonlinearity at a 0.05 mm field). A part off by the field's mean (the shared offset) or
 // missing a term would miss by far more.
 TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
   const ShapeParameters truth = trueShape(ShapeModel::Ellipsoid);
@@ -480,11 +481,15 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
   o.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid};
   // Shifts of the three radii (along the true axes) and the centre.
   Eigen::VectorXd expected_square = Eigen::VectorXd::Zero(6);
+  double expected_absorbed = 0;
   for (int term = 0; term < 4; ++term) {
     Eigen::VectorXd f = term < 3 ? Eigen::VectorXd(normals.col(term)) : Eigen::VectorXd((normals * slice_axis).array().square());
     f.array() -= f.mean();
     const Eigen::MatrixX3d moved = cap + (0.05 * f).asDiagonal() * normals;
-    const ShapeParameters p = articula::fit::fitHierarchy(moved, o).fit(ShapeModel::Ellipsoid).parameters;
+    const articula::fit::ModelFit refit = articula::fit::fitHierarchy(moved, o).fit(ShapeModel::Ellipsoid);
+    const ShapeParameters& p = refit.parameters;
+    // What the fit takes up of the field: the field's sum of squares less what it leaves.
+    expected_absorbed += 0.05 * 0.05 * f.squaredNorm() - refit.sse_mm2;
     const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(p.angles);
     const Eigen::Matrix3d Rt = articula::geometry::rotationFromAngles(truth.angles);
     for (int i = 0; i < 3; ++i) {
@@ -494,6 +499,8 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
   }
   const articula::fit::ParameterUncertainty u =
       articula::fit::parameterUncertainty(truth, cap, {}, articula::fit::UncertaintyMethod::SpatialModel, field);
+  EXPECT_GT(expected_absorbed, 0.5);
+  EXPECT_NEAR(u.edge_offset_absorbed_mm2, expected_absorbed, 0.05 * expected_absorbed);
   for (int k = 0; k < 6; ++k) {
     const double expected = std::sqrt(expected_square[k]);
     EXPECT_GT(expected, 0.005) << k;  // the field moves every one of them

@@ -124,6 +124,35 @@ TEST(ModelSelection, TheNestedFTestCountsTheEffectivePoints) {
   EXPECT_NEAR(step.n_eff, 100.4, 1e-9);
 }
 
+// The test's degrees of freedom are the free parameters: an ovoid's c0x and
+// c0y trade with a and b (one surface), so an ovoid has 6 more than an
+// ellipsoid, not 8; and the part of the fall that the edge offset field the
+// voxels allow would give the richer model's extra parameters is not taken
+// as its gain. Closed forms: F(df1, d2) = (fall / df1) / (SSE / d2).
+TEST(ModelSelection, TheTestCountsFreeParametersAndLeavesTheEdgeFieldsPartOut) {
+  using geometry::ShapeModel;
+  EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Sphere), 4);
+  EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Superellipsoid), 12);
+  EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Ovoid), 15);
+  EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Superovoid), 18);
+  const statistics::ModelEvidence ellipsoid{"ellipsoid", 9, 1000, 10.0, 1000.0, true, 0.02};
+  const statistics::ModelEvidence ovoid{"ovoid", geometry::freeParameterCount(ShapeModel::Ovoid), 1000, 9.9, 1000.0, true,
+                                        0.07};
+  const statistics::NestedStep step = statistics::nestedFTest(ellipsoid, ovoid, 0.05);
+  EXPECT_EQ(step.df1, 6);
+  // The field takes up 0.05 mm^2 more in the ovoid: the gain is 0.05, not 0.1.
+  EXPECT_NEAR(step.f, (0.05 / 6) / (9.9 / 985), 1e-9);
+  // A field the richer model takes up less of (it never can: clamped) adds nothing.
+  statistics::ModelEvidence less = ovoid;
+  less.edge_offset_absorbed_mm2 = 0.0;
+  EXPECT_NEAR(statistics::nestedFTest(ellipsoid, less, 0.05).f, (0.1 / 6) / (9.9 / 985), 1e-9);
+  // A fall the field explains whole is no gain.
+  statistics::ModelEvidence all = ovoid;
+  all.edge_offset_absorbed_mm2 = 0.5;
+  EXPECT_EQ(statistics::nestedFTest(ellipsoid, all, 0.05).f, 0.0);
+  EXPECT_FALSE(statistics::nestedFTest(ellipsoid, all, 0.05).richer_needed);
+}
+
 TEST(ModelSelection, UndeterminedModelsAreNeverSelected) {
   // The ovoid's gain passes its test, but the points leave one of its
   // parameters open: it is listed, not selected; the ellipsoid is.

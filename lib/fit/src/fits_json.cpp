@@ -68,6 +68,7 @@ nlohmann::json modelFitJson(const ModelFit& f) {
           {"standard_errors_table_3_2", errors},
           {"ci95_table_3_2", intervals},
           {"edge_offset_standard_errors_table_3_2", systematic},
+          {"edge_offset_absorbed_mm2", u.edge_offset_absorbed_mm2},
           {"not_identifiable", u.not_identifiable},
           {"gauge", u.gauge},
           {"uncertainty_method", u.method},

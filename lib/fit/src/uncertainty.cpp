@@ -232,6 +232,7 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
     const Eigen::MatrixXd shifts = bread * field_scores;
     systematic = shifts * shifts.transpose();
     covariance += systematic;
+    out.edge_offset_absorbed_mm2 = (field_scores.transpose() * shifts).trace();
   }
   out.edge_offset = edge_offset;
   const double s2 = sse / static_cast<double>(n - k);

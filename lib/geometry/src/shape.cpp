@@ -63,6 +63,8 @@ std::string parameterUnit(ParameterKind kind) {
 
 int parameterCount(ShapeModel m) { return static_cast<int>(parameterNames(m).size()); }
 
+int freeParameterCount(ShapeModel m) { return parameterCount(m) - (hasOvoidCoefficients(m) ? 2 : 0); }
+
 std::vector<std::string> parameterNames(ShapeModel m) {
   std::vector<std::string> names = {"a"};
   if (m != ShapeModel::Sphere) names.insert(names.end(), {"b", "c"});

@@ -28,9 +28,10 @@ bool determinedByPoints(geometry::ShapeModel model, const std::vector<std::strin
 std::vector<ModelEvidence> modelEvidence(const fit::Summary& fits, double n_eff) {
   std::vector<ModelEvidence> out;
   for (const auto& f : fits.fits)
-    out.push_back({geometry::modelName(f.parameters.model), geometry::parameterCount(f.parameters.model), fits.points,
+    out.push_back({geometry::modelName(f.parameters.model), geometry::freeParameterCount(f.parameters.model), fits.points,
                    f.sse_mm2, std::isfinite(n_eff) ? n_eff : f.uncertainty.correlation.n_eff,
-                   determinedByPoints(f.parameters.model, f.uncertainty.not_identifiable)});
+                   determinedByPoints(f.parameters.model, f.uncertainty.not_identifiable),
+                   f.uncertainty.edge_offset_absorbed_mm2});
   return out;
 }
 
@@ -52,7 +53,10 @@ NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer
   step.n_eff = std::sqrt(n_simpler * n_richer);
   if (step.df1 <= 0 || step.df2 <= 0 || !(richer.sse_mm2 > 0) || !std::isfinite(simpler.sse_mm2)) return step;
   // The hierarchy keeps SSE_r <= SSE_s; a hair above from rounding is no fall.
-  const double fall = std::max(0.0, simpler.sse_mm2 - richer.sse_mm2);
+  // Less what the edge offset field the voxels allow would give the richer
+  // model's extra parameters (a slice-shaped offset passes for an egg's terms).
+  const double field = std::max(0.0, richer.edge_offset_absorbed_mm2 - simpler.edge_offset_absorbed_mm2);
+  const double fall = std::max(0.0, simpler.sse_mm2 - richer.sse_mm2 - field);
   step.f = (fall / step.df1) / (richer.sse_mm2 / step.df2) * step.n_eff / n;
   step.p_value = boost::math::cdf(boost::math::complement(boost::math::fisher_f(step.df1, step.df2), step.f));
   step.richer_needed = step.p_value < alpha;

@@ -238,7 +238,9 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
     }
     json errors = errors_by_model.count(name) ? errors_by_model[name] : json::object();
     errors.erase("model");
-    const int k = geometry::parameterCount(shape.model);
+    // The parameters the surface pins down (an ovoid's scales c0x, c0y are its gauge): the
+    // nested tests' degrees of freedom and AIC / BIC count these.
+    const int k = geometry::freeParameterCount(shape.model);
     const int n = errors.value("n_points", 0);
     const double sse = errors.value("sse_mm2", 0.0);
     json entry = {{"model", name}, {"n_parameters", k}, {"parameters", parameters}, {"errors", errors}};
@@ -296,6 +298,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
       e.n_eff = fit_entry.at("residual_correlation").value("n_eff", NAN);
     // An ovoid's c0x and c0y are its gauge (fits.json "gauge"), never listed as not identifiable.
     e.determined = statistics::determinedByPoints(shapes[i].model, m.value("not_identifiable", std::vector<std::string>{}));
+    e.edge_offset_absorbed_mm2 = fit_entry.value("edge_offset_absorbed_mm2", 0.0);
     evidence.push_back(e);
   }
   const statistics::ModelSelection selection = statistics::selectNested(evidence, o.selection_alpha);

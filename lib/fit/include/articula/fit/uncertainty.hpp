@@ -80,6 +80,10 @@ struct ParameterUncertainty {
   Eigen::VectorXd independent_standard_error;  // what independent residuals would give, for comparison
   Eigen::VectorXd systematic_standard_error;  // the edge offset field's part of standard_error (0: none)
   EdgeOffsetField edge_offset;              // the field used
+  /// The sum of squares of the field that this model's parameters take up,
+  /// expected over the field (sum_k sd_k^2 f_k^T J (J^T J)^-1 J^T f_k, mm^2):
+  /// what a richer model's gain over a simpler one may owe to the field.
+  double edge_offset_absorbed_mm2 = 0;
   std::vector<std::string> not_identifiable;  // parameter names: a near-singular J^T J or a very wide interval
   std::vector<std::string> gauge;           // held at their fitted values: an ovoid's c0x and c0y
   double condition_number = 0;              // of J^T J with unit-scaled columns, gauge held

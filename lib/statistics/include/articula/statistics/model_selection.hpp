@@ -67,11 +67,12 @@ double bic(double sse, int n, int k);
 /// those they share). When no model is determined, all take part.
 struct ModelEvidence {
   std::string model;
-  int n_parameters = 0;
+  int n_parameters = 0;  // free ones (geometry::freeParameterCount): the F test's degrees of freedom
   int n_points = 0;
   double sse_mm2 = NAN;
   double n_eff = NAN;  // NaN: taken as n_points (independent residuals)
   bool determined = true;
+  double edge_offset_absorbed_mm2 = 0;  // fits.json's: the edge offset field's sum of squares the model takes up
 };
 struct NestedStep {
   std::string simpler, richer;
