@@ -206,6 +206,18 @@ TEST(ImagingIo, NiftiHeadersPromisingMoreThanTheFileHoldsAreRefused) {
   std::memcpy(&swapped[0], &little_size, 4);
   refused("swapped.nii", swapped + voxels, "truncated");
   refused("rank.nii", niftiHeader(false, 0, 4, 4, 4) + voxels, "dim[0]");
+  // A header size of 540 without NIfTI-2's magic "n+2": nifti1_io reads it in
+  // NIfTI-1's layout (11776 x 31335 voxels: 369 MB, then 1.5 GB as floats).
+  std::string sized = niftiHeader(false, 3, 11776, 31335, 1, "\0\0\0\0") + std::string(200, '\0');
+  const std::int32_t nifti2_size = 540;
+  std::memcpy(&sized[0], &nifti2_size, 4);
+  refused("sized540.nii", sized + voxels, "truncated");
+  // With NIfTI-2's magic as well (fuzz/fuzz_nifti's find): ITK 5.2 reads
+  // NIfTI-1 only and took it for that 1.5 GB Analyze image.
+  std::memcpy(&sized[4], "n+2\0", 4);
+  const std::string itk = imaging::itkVersion();
+  if (itk.rfind("4.", 0) == 0 || itk.rfind("5.0", 0) == 0 || itk.rfind("5.1", 0) == 0 || itk.rfind("5.2", 0) == 0)
+    refused("nifti2.nii", sized + voxels, "NIfTI-2");
   std::filesystem::remove_all(dir);
 }
 

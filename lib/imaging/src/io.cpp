@@ -111,7 +111,21 @@ void checkNiftiFile(const fs::path& path) {
   for (bool order : {false, true}) {
     const auto size = static_cast<std::int32_t>(bytes(0, 4, order));
     if (size != 348 && !(size == 540 && got >= 540)) continue;
-    const bool v1 = size == 348;
+    // A NIfTI-2 header says so by its size and its magic "n+2"; nifti1_io
+    // reads any other header in NIfTI-1's layout (without "n+1", as Analyze),
+    // and so it is checked here.
+    const bool v1 = !(size == 540 && std::memcmp(header + 4, "n+2", 3) == 0);
+#if ITK_VERSION_MAJOR < 5 || (ITK_VERSION_MAJOR == 5 && ITK_VERSION_MINOR < 3)
+    // Before 5.3 ITK reads NIfTI-1 only: a NIfTI-2 file it takes for an
+    // Analyze image in NIfTI-1's layout, other dimensions than the file's
+    // (a 553-byte file asked for 1.5 GB).
+    if (!v1) {
+      gzclose(file);
+      throw InputError(path.string() + ": a NIfTI-2 header (540 bytes, magic n+2), which the ITK " +
+                       itk::Version::GetITKVersion() + " of this build does not read; expected NIfTI-1: convert it " +
+                       "(for example nibabel's nib.Nifti1Image(img.dataobj, img.affine).to_filename(...))");
+    }
+#endif
     // ITK reads NIfTI-1 with nifti1_io, which takes the byte order from dim[0]
     // unless it is 0 (and only then from the header size): every field below
     // is read in the order ITK will use, or the checks would judge other
@@ -187,7 +201,6 @@ void checkNiftiFile(const fs::path& path) {
     // So the stream is measured here, at the cost of one more decompression.
     // For NIfTI-1 this holds whatever the magic says: ITK reads a .nii without
     // "n+1" as an Analyze image, from the same file.
-    const bool single_file = v1 || std::memcmp(header + 4, "n+2", 3) == 0;
     const double rank = dim(0);
     const auto datatype = static_cast<std::int16_t>(bytes(v1 ? 70 : 12, 2, swap));
     const double bitpix = double(static_cast<std::int16_t>(bytes(v1 ? 72 : 14, 2, swap)));
@@ -207,7 +220,7 @@ void checkNiftiFile(const fs::path& path) {
     const double stored_offset = v1 ? real(108) : double(static_cast<std::int64_t>(bytes(168, 8, swap)));
     // The voxels start after the header, whatever the header says.
     const double offset = std::isfinite(stored_offset) ? std::max(stored_offset, double(size)) : double(size);
-    if (single_file && rank >= 1 && rank <= 7) {
+    if (rank >= 1 && rank <= 7) {
       // Counts for messages; a header may promise more than a long long holds.
       const auto number = [](double v) {
         if (v < 9e18) return std::to_string(std::llround(v));

@@ -397,7 +397,8 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"edge_offset_field", fits.value("edge_offset_field", json(nullptr))},
       {"selection",
        {{"rule",
-         "each model the points determine (not undetermined) is tested against every determined model containing it (F = ((SSE_simpler - SSE_richer) / df1) / (SSE_richer / df2) x n_eff / n, "
+         "each model the points determine (not undetermined) is tested against every determined model containing it (F = ((SSE_simpler - SSE_richer - the edge offset field's part) / df1) / (SSE_richer / df2) x n_eff / n, df1 the "
+         "extra free parameters, "
          "n_eff the points' effective number of independent points for errors correlated over length_mm; with "
          "length_mm 0, the geometric mean of the two models' from their residuals) at alpha / their number; a model "
          "is supported when it is the simplest or needed over every supported model it contains; the selected model "

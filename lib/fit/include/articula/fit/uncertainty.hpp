@@ -67,10 +67,11 @@ struct EdgeOffsetField {
   bool active() const { return linear_sd_mm > 0 || across_slices_sd_mm > 0; }
 };
 
-/// The field's size for a CT's voxels (`spacing_mm`: within a slice, within a
-/// slice, across; the last the larger of the slices' spacing and thickness)
-/// and slice axis, set from the phantom benches of three generators
-/// (docs/benchmarks.md).
+/// The field's size for a CT's voxels (`spacing_mm`: along the grid's i, j
+/// and k, k across the slices) and slice axis (the grid's k direction), set
+/// from the phantom benches of three generators (docs/benchmarks.md). Slices
+/// thicker than their spacing are taken at their spacing: a label's header
+/// holds no thickness.
 EdgeOffsetField edgeOffsetField(const Eigen::Vector3d& spacing_mm, const Eigen::Vector3d& slice_axis);
 
 struct ParameterUncertainty {
