@@ -137,9 +137,10 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
     shape.radii[1] *= fitted.cy[0];
     shape.cx /= fitted.cx[0];
     shape.cy /= fitted.cy[0];
+    const auto gauge = geometry::gaugeParameterNames(fitted.model);
     for (Eigen::Index j = 0; j < m; ++j) {
       const std::string& name = names[static_cast<size_t>(j)];
-      if (name == "c0x" || name == "c0y") held[static_cast<size_t>(j)] = 1;
+      if (std::find(gauge.begin(), gauge.end(), name) != gauge.end()) held[static_cast<size_t>(j)] = 1;
       else if (name == "a") to_raw[j] = 1.0 / fitted.cx[0];
       else if (name == "b") to_raw[j] = 1.0 / fitted.cy[0];
       else if (name.size() == 3 && name[0] == 'c') to_raw[j] = name[2] == 'x' ? fitted.cx[0] : fitted.cy[0];

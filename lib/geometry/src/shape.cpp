@@ -63,7 +63,11 @@ std::string parameterUnit(ParameterKind kind) {
 
 int parameterCount(ShapeModel m) { return static_cast<int>(parameterNames(m).size()); }
 
-int freeParameterCount(ShapeModel m) { return parameterCount(m) - (hasOvoidCoefficients(m) ? 2 : 0); }
+std::vector<std::string> gaugeParameterNames(ShapeModel m) {
+  return hasOvoidCoefficients(m) ? std::vector<std::string>{"c0x", "c0y"} : std::vector<std::string>{};
+}
+
+int freeParameterCount(ShapeModel m) { return parameterCount(m) - static_cast<int>(gaugeParameterNames(m).size()); }
 
 std::vector<std::string> parameterNames(ShapeModel m) {
   std::vector<std::string> names = {"a"};

@@ -633,14 +633,8 @@ Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, Re
 
 ImageGeometry readImageGeometry(const fs::path& input) {
   if (!fs::is_regular_file(input)) throw InputError("image not found: " + input.string());
-  const itk::ImageIOBase::Pointer io = imageIoFor(input);
+  const itk::ImageIOBase::Pointer io = readImageHeader(input);
   if (!io) throw InputError("expected an image (.nii.gz/.nii/.nrrd/.mha), found " + input.string());
-  try {
-    io->SetFileName(input.string());
-    io->ReadImageInformation();
-  } catch (const itk::ExceptionObject& e) {
-    throw InputError("could not read the image header of " + input.string() + ": " + e.GetDescription());
-  }
   if (io->GetNumberOfDimensions() != 3)
     throw InputError("expected a 3-D image, found " + std::to_string(io->GetNumberOfDimensions()) + " dimensions in " +
                      input.string());

@@ -109,22 +109,31 @@ inline itk::IOComponentEnum storedComponentType(const std::filesystem::path& pat
   return io->GetComponentType();
 }
 
+/// The reader of `path`'s format with its header read (no voxels); null when
+/// ITK has no reader for its extension. Throws InputError naming the file
+/// when the header cannot be read.
+inline itk::ImageIOBase::Pointer readImageHeader(const std::filesystem::path& path) {
+  const itk::ImageIOBase::Pointer io = imageIoFor(path);
+  if (!io) return io;
+  try {
+    io->SetFileName(path.string());
+    io->ReadImageInformation();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("could not read the image header of " + path.string() + ": " + e.GetDescription());
+  } catch (const std::exception& e) {
+    throw InputError("could not read the image header of " + path.string() + ": " + excerpt(e.what()));
+  }
+  return io;
+}
+
 template <typename T>
 Image<T> readImageFile(const std::filesystem::path& path) {
   checkNiftiFile(path);
   checkImageDataLength(path);
   // What the file holds, before ITK reads it as 3-D (it would silently take
   // the first volume of a 4-D image and the first component of a vector).
-  const itk::ImageIOBase::Pointer io = imageIoFor(path);
+  const itk::ImageIOBase::Pointer io = readImageHeader(path);
   if (io) {
-    try {
-      io->SetFileName(path.string());
-      io->ReadImageInformation();
-    } catch (const itk::ExceptionObject& e) {
-      throw InputError("could not read the image header of " + path.string() + ": " + e.GetDescription());
-    } catch (const std::exception& e) {
-      throw InputError("could not read the image header of " + path.string() + ": " + excerpt(e.what()));
-    }
     for (unsigned d = 3; d < io->GetNumberOfDimensions(); ++d)
       if (io->GetDimensions(d) > 1)
         throw InputError(path.string() + ": expected one 3-D volume, found " + std::to_string(io->GetNumberOfDimensions()) +

@@ -34,8 +34,11 @@ struct ShapeParameters {
 
 /// Number of parameters M of thesis table 3.2: 4, 9, 12, 17, 20.
 int parameterCount(ShapeModel model);
-/// The parameters a surface pins down: 4, 9, 12, 15, 18. An ovoid's (a, c_jx)
-/// and (k a, c_jx / k) are one surface, and so for b and c_jy: two fewer.
+/// The parameters a fit holds fixed because the surface does not pin them
+/// down: an ovoid's (a, c_jx) and (k a, c_jx / k) are one surface, and so for
+/// b and c_jy, so c0x and c0y (the gauge); none for the other models.
+std::vector<std::string> gaugeParameterNames(ShapeModel model);
+/// The parameters a surface pins down: parameterCount less the gauge (4, 9, 12, 15, 18).
 int freeParameterCount(ShapeModel model);
 /// Names in table 3.2 order, e.g. {"a","b","c","gamma1",...,"t1","t2","t3","phi","theta","psi"}.
 std::vector<std::string> parameterNames(ShapeModel model);
