@@ -477,13 +477,17 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
   field.slice_axis = slice_axis;
   field.linear_sd_mm = 0.05;
   field.across_slices_sd_mm = 0.05;
+  field.odd_across_slices_sd_mm = 0.05;
   Options o;
   o.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid};
   // Shifts of the three radii (along the true axes) and the centre.
   Eigen::VectorXd expected_square = Eigen::VectorXd::Zero(6);
   double expected_absorbed = 0;
-  for (int term = 0; term < 4; ++term) {
-    Eigen::VectorXd f = term < 3 ? Eigen::VectorXd(normals.col(term)) : Eigen::VectorXd((normals * slice_axis).array().square());
+  for (int term = 0; term < 5; ++term) {
+    const Eigen::VectorXd across = normals * slice_axis;
+    Eigen::VectorXd f = term < 3    ? Eigen::VectorXd(normals.col(term))
+                        : term == 3 ? Eigen::VectorXd(across.array().square())
+                                    : Eigen::VectorXd(across.array().cube());
     f.array() -= f.mean();
     const Eigen::MatrixX3d moved = cap + (0.05 * f).asDiagonal() * normals;
     const articula::fit::ModelFit refit = articula::fit::fitHierarchy(moved, o).fit(ShapeModel::Ellipsoid);

@@ -156,7 +156,8 @@ nlohmann::json fitsDocument(const Summary& summary, const std::string& input, co
     field = {{"voxel_spacing_mm", list(e.spacing_mm)},
              {"slice_axis_lps", list(e.slice_axis)},
              {"linear_sd_mm", e.linear_sd_mm},
-             {"across_slices_sd_mm", e.across_slices_sd_mm}};
+             {"across_slices_sd_mm", e.across_slices_sd_mm},
+             {"odd_across_slices_sd_mm", e.odd_across_slices_sd_mm}};
   }
   return {{"coordinate_system", "LPS"},
           {"units", "mm"},

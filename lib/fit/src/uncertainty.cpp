@@ -26,8 +26,10 @@ constexpr double kRelativeSingularValue = 1e-10;
 // (a head's centre moved by 0.01-0.05 mm at 1 x 1 x 2 mm, towards its neck);
 // the across-slice field's kAcrossBaseMm + kAcrossPerMm4 s^4 for slices of s
 // (the surface's offset across slices less that within them: 0.02-0.06 mm up
-// to 2 mm slices, 0.11-0.17 mm at 3 mm).
-constexpr double kLinearPerMm2 = 0.01, kAcrossBaseMm = 0.03, kAcrossPerMm4 = 0.0025;
+// to 2 mm slices, 0.11-0.17 mm at 3 mm); the odd term across slices as
+// large (a dome's offset unlike its far side's: egg terms found on
+// superellipsoids at 2-3 mm slices).
+constexpr double kLinearPerMm2 = 0.01, kAcrossBaseMm = 0.03, kAcrossPerMm4 = 0.0025, kOddToEven = 1.0;
 
 /// Half-widths beyond which an interval says nothing about the head: a
 /// radius or position known to only +-10 mm, an angle to +-45 degrees, an
@@ -95,6 +97,7 @@ EdgeOffsetField edgeOffsetField(const Eigen::Vector3d& spacing_mm, const Eigen::
   f.spacing_mm = spacing_mm;
   f.linear_sd_mm = kLinearPerMm2 * spacing_mm.maxCoeff() * spacing_mm.maxCoeff();
   f.across_slices_sd_mm = kAcrossBaseMm + kAcrossPerMm4 * std::pow(spacing_mm[2], 4);
+  f.odd_across_slices_sd_mm = kOddToEven * f.across_slices_sd_mm;
   return f;
 }
 
@@ -151,18 +154,21 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
   parameterGradient(shape, feet, full, gradient_norms);
   // The derivatives of the signed distances (envelope theorem, parameter_gradient.hpp).
   for (Eigen::Index i = 0; i < n; ++i) full.row(i) /= std::max(gradient_norms[i], 1e-300);
-  // The edge offset's fields n_x, n_y, n_z, (n . s)^2, each less its mean
+  // The edge offset's fields n_x, n_y, n_z, (n . s)^2, (n . s)^3, each less its mean
   // and times its standard deviation; n, the fitted surface's normal at each
   // foot, is minus the distances' derivatives along t1..t3.
-  Eigen::MatrixX4d fields;
+  Eigen::MatrixXd fields;
   if (edge_offset.active()) {
     const auto t = std::find(names.begin(), names.end(), "t1") - names.begin();
-    fields.resize(n, 4);
+    fields.resize(n, 5);
     fields.leftCols(3) = -full.middleCols(t, 3);
-    fields.col(3) = (fields.leftCols(3) * edge_offset.slice_axis).array().square().matrix();
+    const Eigen::VectorXd across = fields.leftCols(3) * edge_offset.slice_axis;
+    fields.col(3) = across.array().square().matrix();
+    fields.col(4) = across.array().cube().matrix();
     fields.rowwise() -= fields.colwise().mean();
     fields.leftCols(3) *= edge_offset.linear_sd_mm;
     fields.col(3) *= edge_offset.across_slices_sd_mm;
+    fields.col(4) *= edge_offset.odd_across_slices_sd_mm;
   }
   std::vector<Eigen::Index> active;
   for (Eigen::Index j = 0; j < m; ++j)

@@ -136,7 +136,7 @@ std::string verdictSection(const json& results) {
   if (results.contains("edge_offset_field") && results.at("edge_offset_field").is_object())
     note += ", and an edge offset varying over the surface, sized from the CT's voxels (standard deviations " +
             fixed(numberAt(results.at("edge_offset_field"), "linear_sd_mm"), 3) + " mm for a tilt, " +
-            fixed(numberAt(results.at("edge_offset_field"), "across_slices_sd_mm"), 3) + " mm across the slices)";
+            fixed(numberAt(results.at("edge_offset_field"), "across_slices_sd_mm"), 3) + " mm across the slices, its odd part as large)";
   note += ". It does not hold a shift of the whole surface shared by every point (an edge found outside a thin "
           "cortex): the radii carry it.";
   return html + "</table>\n<p class=\"note\">" + note + "</p></section>\n";

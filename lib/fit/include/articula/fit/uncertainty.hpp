@@ -56,15 +56,17 @@ std::string uncertaintyMethodName(UncertaintyMethod m);
 /// "spatial-model", "independent", "spatial-hac", "patch-bootstrap"; throws UsageError otherwise.
 UncertaintyMethod uncertaintyMethodFromName(const std::string& name);
 
-/// A surface offset beta . n + gamma (n . slice_axis)^2 over the surface
-/// normals n, its coefficients shared by the points of one scan: beta with
-/// standard deviation linear_sd_mm in each direction, gamma across_slices_sd_mm.
+/// A surface offset beta . n + gamma (n . slice_axis)^2 + delta (n . slice_axis)^3
+/// over the surface normals n, its coefficients shared by the points of one
+/// scan: beta with standard deviation linear_sd_mm in each direction, gamma
+/// across_slices_sd_mm, delta odd_across_slices_sd_mm.
 struct EdgeOffsetField {
   Eigen::Vector3d slice_axis = Eigen::Vector3d::UnitZ();  // unit slice normal, LPS
   Eigen::Vector3d spacing_mm = Eigen::Vector3d::Zero();   // the voxels it was sized for (0: none)
   double linear_sd_mm = 0;
   double across_slices_sd_mm = 0;
-  bool active() const { return linear_sd_mm > 0 || across_slices_sd_mm > 0; }
+  double odd_across_slices_sd_mm = 0;  // one side of the slices' offset unlike the other's (a dome's and its far side's)
+  bool active() const { return linear_sd_mm > 0 || across_slices_sd_mm > 0 || odd_across_slices_sd_mm > 0; }
 };
 
 /// The field's size for a CT's voxels (`spacing_mm`: along the grid's i, j
