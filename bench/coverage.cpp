@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
                                       {"model", articula::geometry::modelName(shape.model)},
                                       {"method", u.method},
                                       {"offset_mm", offset},
-                                      {"edge_offset_sd_mm", {field.linear_sd_mm, field.across_slices_sd_mm}},
+                                      {"edge_offset_sd_mm", {field.linear_sd_mm, field.across_slices_sd_mm, field.odd_across_slices_sd_mm}},
                                       {"centre_z", centre},
                                       {"radius_z", radius},
                                       {"radius_less_offset_z", radius_offset},
