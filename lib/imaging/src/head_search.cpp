@@ -213,8 +213,9 @@ class LatticeLookup {
 /// The head's edge distance per lattice direction, with the holes of its cap
 /// (a missed edge, the fovea's pit) filled from their neighbours: a
 /// direction without an edge whose nearest neighbours mostly have one lies
-/// inside the cap. The neck's directions, without neighbours on the cap, stay empty.
-std::vector<double> capEdges(const HeadCandidate& head) {
+/// inside the cap. The neck's directions, without neighbours on the cap, stay
+/// empty. `slice_axis`: the grid's slice normal (unit, LPS).
+std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis) {
   std::vector<double> edge = head.edge_mm;
   constexpr int kNeighbours = 6;
   std::vector<std::vector<int>> neighbours(kRayCount);
@@ -226,10 +227,12 @@ std::vector<double> capEdges(const HeadCandidate& head) {
     std::partial_sort(by_angle.begin(), by_angle.begin() + kNeighbours, by_angle.end());
     for (int k = 0; k < kNeighbours; ++k) neighbours[static_cast<size_t>(n)].push_back(by_angle[static_cast<size_t>(k)].second);
   }
-  for (int pass = 0; pass < 2; ++pass) {
+  // One ring of the holes filled: a direction without an edge, among those
+  // `where` admits, takes the mean edge of its neighbours if most have one.
+  const auto fillRing = [&](const auto& where) {
     std::vector<double> next = edge;
     for (int n = 0; n < kRayCount; ++n) {
-      if (!std::isnan(edge[static_cast<size_t>(n)])) continue;
+      if (!std::isnan(edge[static_cast<size_t>(n)]) || !where(n)) continue;
       double sum = 0;
       int count = 0;
       for (int m : neighbours[static_cast<size_t>(n)])
@@ -237,7 +240,15 @@ std::vector<double> capEdges(const HeadCandidate& head) {
       if (count >= 4) next[static_cast<size_t>(n)] = sum / count;
     }
     edge = next;
-  }
+  };
+  for (int ring = 0; ring < 2; ++ring) fillRing([](int) { return true; });
+  // The rays within kPoleDeg of the slice axis cross the dome's edge in one
+  // or two slices and at 3 mm slices often miss it: a hole at the pole that
+  // two rings leave open keeps a column of the socket's roof in the label.
+  constexpr double kPoleDeg = 15;
+  const double pole_cos = std::cos(kPoleDeg * M_PI / 180);
+  for (int ring = 0; ring < 3; ++ring)
+    fillRing([&](int n) { return std::abs(geometry::fibonacciDirection(n, kRayCount).dot(slice_axis)) >= pole_cos; });
   return edge;
 }
 
@@ -250,8 +261,8 @@ std::vector<double> capEdges(const HeadCandidate& head) {
 /// CT's edge within them).
 void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head) {
   static const LatticeLookup lookup;
-  const std::vector<double> edge = capEdges(head);
   const ImageGeometry& g = mask.geometry;
+  const std::vector<double> edge = capEdges(head, g.direction.col(2));
   const double margin = std::max(0.5, 0.5 * g.spacing.maxCoeff());
   long long removed = 0;
   for (int k = 0; k < g.size[2]; ++k)
