@@ -483,8 +483,8 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
   // Shifts of the three radii (along the true axes) and the centre.
   Eigen::VectorXd expected_square = Eigen::VectorXd::Zero(6);
   double expected_absorbed = 0;
+  const Eigen::VectorXd across = normals * slice_axis;
   for (int term = 0; term < 5; ++term) {
-    const Eigen::VectorXd across = normals * slice_axis;
     Eigen::VectorXd f = term < 3    ? Eigen::VectorXd(normals.col(term))
                         : term == 3 ? Eigen::VectorXd(across.array().square())
                                     : Eigen::VectorXd(across.array().cube());

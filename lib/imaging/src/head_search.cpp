@@ -218,9 +218,16 @@ class LatticeLookup {
 std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis) {
   std::vector<double> edge = head.edge_mm;
   constexpr int kNeighbours = 6;
+  // The rays within kPoleDeg of the slice axis cross the dome's edge in one
+  // or two slices and at 3 mm slices often miss it: a hole at the pole that
+  // two rings leave open keeps a column of the socket's roof in the label.
+  constexpr double kPoleDeg = 15;
+  const double pole_cos = std::cos(kPoleDeg * M_PI / 180);
   std::vector<std::vector<int>> neighbours(kRayCount);
+  std::vector<char> at_pole(kRayCount);
   for (int n = 0; n < kRayCount; ++n) {
     const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
+    at_pole[static_cast<size_t>(n)] = std::abs(u.dot(slice_axis)) >= pole_cos;
     std::vector<std::pair<double, int>> by_angle;
     for (int m = 0; m < kRayCount; ++m)
       if (m != n) by_angle.emplace_back(-u.dot(geometry::fibonacciDirection(m, kRayCount)), m);
@@ -242,13 +249,7 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
     edge = next;
   };
   for (int ring = 0; ring < 2; ++ring) fillRing([](int) { return true; });
-  // The rays within kPoleDeg of the slice axis cross the dome's edge in one
-  // or two slices and at 3 mm slices often miss it: a hole at the pole that
-  // two rings leave open keeps a column of the socket's roof in the label.
-  constexpr double kPoleDeg = 15;
-  const double pole_cos = std::cos(kPoleDeg * M_PI / 180);
-  for (int ring = 0; ring < 3; ++ring)
-    fillRing([&](int n) { return std::abs(geometry::fibonacciDirection(n, kRayCount).dot(slice_axis)) >= pole_cos; });
+  for (int ring = 0; ring < 3; ++ring) fillRing([&at_pole](int n) { return at_pole[static_cast<size_t>(n)] != 0; });
   return edge;
 }
 
