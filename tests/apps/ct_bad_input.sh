@@ -79,6 +79,10 @@ slices && cp "$T/p/dicom/slice_0030.dcm" "$T/s/slice_0030b.dcm"
 expect 3 "slice_0030.dcm (slice 31 of 65) and slice_0030b.dcm (slice 32 of 65) lie at one position along the slice normal (a duplicated slice?)" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
 grep -q "gdcm\|Error: In" "$T/err" && { echo "FAIL: GDCM's raw lines reach the user:"; cat "$T/err"; fail=1; }
+# A Recognition Code that is not ACR-NEMA's (GDCM asserted on it and aborted).
+slices && $edit "$T/p/dicom/slice_0030.dcm" "$T/s/slice_0030.dcm" 0008,0010=1.2.840.10008.5.1.4.1.1.2
+expect 3 "^  slice_0030.dcm: element (0008,0010) (Recognition Code, of ACR-NEMA files) at byte [0-9]* holds '1.2.840.10008.5.1.4.1.1.2'; expected a code beginning with ACR-NEMA" -- \
+  "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
 slices && $edit "$T/p/dicom/slice_0030.dcm" "$T/s/slice_0030.dcm" 7FE0,0010=drop  # GDCM skips it
 expect 3 "missing slice?); the folder holds 1 file(s) that could not be read as DICOM: slice_0030.dcm" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"

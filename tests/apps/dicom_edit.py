@@ -7,7 +7,8 @@ hostile file would have them (the tests' probes; pydicom is not a dependency).
 TAG is "gggg,eeee". VALUE is text for string elements (DS, IS, ...), "us:N"
 for a 16-bit number (Rows, Columns, ...), "cut:N" to keep only the first N
 bytes of the element's value (its length then says N: a slice whose pixel data
-is short of what its Rows x Columns announce), or "drop" to remove it.
+is short of what its Rows x Columns announce), or "drop" to remove it. A text
+or number for an element the file lacks inserts it in its place.
 Reads and writes the meta header in explicit VR little endian and the data set
 in implicit VR little endian, as `articula phantom` writes them.
 """
@@ -63,21 +64,26 @@ def main():
         g, e = (int(x, 16) for x in tag.split(","))
         wanted[(g, e)] = value
     out = bytearray(data[:end])
+
+    def put(tag, value):
+        out.extend(struct.pack("<HHI", tag[0], tag[1], len(value)) + value)
+
+    def edited(edit, value):
+        if edit.startswith("us:"):
+            return struct.pack("<H", int(edit[3:]))
+        if edit.startswith("cut:"):
+            return value[:int(edit[4:])]
+        value = edit.encode()
+        return value + b" " if len(value) % 2 else value
+
     for tag, pos, head, length, _ in elements(data, end, False):
+        for missing in sorted(t for t in wanted if t < tag and not wanted[t].startswith(("drop", "cut:"))):
+            put(missing, edited(wanted.pop(missing), b""))
         value = bytes(data[pos + head:pos + head + length])
         edit = wanted.pop(tag, None)
         if edit == "drop":
             continue
-        if edit is not None:
-            if edit.startswith("us:"):
-                value = struct.pack("<H", int(edit[3:]))
-            elif edit.startswith("cut:"):
-                value = value[:int(edit[4:])]
-            else:
-                value = edit.encode()
-                if len(value) % 2:
-                    value += b" "
-        out += struct.pack("<HHI", tag[0], tag[1], len(value)) + value
+        put(tag, value if edit is None else edited(edit, value))
     if wanted:
         raise SystemExit(f"dicom_edit.py: {source} has no element {sorted(wanted)}")
     open(target, "wb").write(out)

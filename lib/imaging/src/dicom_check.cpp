@@ -58,6 +58,7 @@ const char* standardVr(std::uint32_t tag) {
 
 constexpr std::uint32_t kUndefinedLength = 0xFFFFFFFFu;
 constexpr std::uint32_t kPixelData = 0x7FE00010u;
+constexpr std::uint32_t kRecognitionCode = 0x00080010u;
 constexpr std::uint32_t kItem = 0xFFFEE000u, kItemEnd = 0xFFFEE00Du, kSequenceEnd = 0xFFFEE0DDu;
 constexpr int kMaxNesting = 64;  // deeper is no real file, and would only grow the stack
 
@@ -133,6 +134,9 @@ class Walker {
       length = read32();
     }
     if (length == kUndefinedLength) {
+      if (depth == 0 && tag == kRecognitionCode)
+        throw Broken("element " + tagName(tag) + " (Recognition Code) at byte " + std::to_string(start) +
+                     " has an undefined length; it holds a short text");
       if (depth == 0 && header && tag == kPixelData) header->pixel_data_bytes = DicomSliceHeader::kEncapsulated;
       items(depth + 1, tag, start);
     } else if (depth == 0 && header && capture(tag, length, start)) {
@@ -223,6 +227,7 @@ class Walker {
         header->pixel_data_bytes = length;
         skip(length, tag, start);
         return true;
+      case kRecognitionCode: checkRecognitionCode(length, start); return true;
       default: return false;
     }
     if (text && length <= 256) {
@@ -241,6 +246,24 @@ class Walker {
       return true;
     }
     return false;
+  }
+
+  // An ACR-NEMA data set's (0008,0010): GDCM takes any data set holding a
+  // non-empty one for ACR-NEMA and aborts the process unless it begins as
+  // those do.
+  void checkRecognitionCode(std::uint32_t length, std::uint64_t start) {
+    need(length, kRecognitionCode, start);
+    if (length > 256)
+      throw Broken("element " + tagName(kRecognitionCode) + " (Recognition Code) at byte " + std::to_string(start) +
+                   " holds " + std::to_string(length) + " bytes; it holds a short text");
+    std::string code = bytes(length);
+    if (code.empty()) return;  // GDCM passes an empty one by
+    for (const char* acr_nema : {"ACR-NEMA", "ACRNEMA", "MIPS 2.0"})
+      if (code.rfind(acr_nema, 0) == 0) return;
+    while (!code.empty() && (code.back() == ' ' || code.back() == '\0')) code.pop_back();  // the value's padding
+    throw Broken("element " + tagName(kRecognitionCode) + " (Recognition Code, of ACR-NEMA files) at byte " +
+                 std::to_string(start) + " holds '" + excerpt(code) +
+                 "'; expected a code beginning with ACR-NEMA, ACRNEMA or MIPS 2.0");
   }
 
   std::uint32_t number(int n) {

@@ -365,8 +365,8 @@ const std::vector<StageOption>& stageOptions(const std::string& stage) {
 std::vector<StageOptionOf> optionsRunAs(const std::string& run_name) {
   std::vector<StageOptionOf> found;
   for (const auto& stage : stages())
-    for (const auto& option : stage.options)
-      if (option.runName() == run_name) found.push_back({stage.name, &option});
+    for (const auto& declared : stage.options)
+      if (declared.runName() == run_name) found.push_back({stage.name, &declared});
   return found;
 }
 
