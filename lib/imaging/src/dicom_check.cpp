@@ -15,6 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <gdcmDict.h>
+#include <gdcmDicts.h>
+#include <gdcmGlobal.h>
+#include <gdcmVR.h>
+
 #include "articula/core/error.hpp"
 #include "articula/core/excerpt.hpp"
 
@@ -34,6 +39,32 @@ std::vector<double> dicomNumbers(const std::string& text) {
 }
 
 namespace {
+
+// The groups of the elements GDCM reads to describe an image (identity and
+// modality, acquisition, position, pixels, dose grids, nuclear medicine),
+// each through a typed attribute that asserts, and aborts the process, when
+// the file's VR does not fit the dictionary's.
+bool imageDescribingGroup(std::uint32_t tag) {
+  const std::uint32_t group = tag >> 16;
+  return group == 0x0008 || group == 0x0018 || group == 0x0020 || group == 0x0028 || group == 0x0054 ||
+         group == 0x3004 || group == 0x5200;
+}
+
+// The dictionary's VR (e.g. "US or SS") when an image-describing element's
+// explicit VR `vr` does not fit it, as GDCM's attributes test it; empty when
+// it fits or the element is not one of those. GDCM's own dictionary, so that
+// the walk refuses what GDCM would abort on and nothing more.
+std::string dictionaryVrRefusing(std::uint32_t tag, const std::string& vr) {
+  if (!imageDescribingGroup(tag)) return {};
+  const gdcm::Tag gdcm_tag(static_cast<std::uint16_t>(tag >> 16), static_cast<std::uint16_t>(tag & 0xFFFFu));
+  const gdcm::DictEntry& entry = gdcm::Global::GetInstance().GetDicts().GetPublicDict().GetDictEntry(gdcm_tag);
+  const gdcm::VR expected = entry.GetVR();
+  if (expected == gdcm::VR::INVALID || expected == gdcm::VR::UN) return {};  // not in the dictionary
+  if (expected.Compatible(gdcm::VR(gdcm::VR::GetVRTypeFromFile(vr.c_str())))) return {};
+  std::string text = gdcm::VR::GetVRString(expected);
+  for (size_t at = text.find('_'); at != std::string::npos; at = text.find('_')) text.replace(at, 1, " or ");
+  return text;
+}
 
 // The value representations of the elements that describe an image, as the
 // standard gives them: GDCM reads these through typed attributes and aborts
@@ -118,6 +149,9 @@ class Walker {
         if (const char* expected = standardVr(tag); expected && !std::strstr(expected, vr.c_str()))
           throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has the value representation '" +
                        vr + "', the standard's is " + expected);
+      if (const std::string expected = dictionaryVrRefusing(tag, vr); !expected.empty())
+        throw Broken("element " + tagName(tag) + " at byte " + std::to_string(start) + " has the value representation '" +
+                     vr + "', the standard's is " + expected);
       // PS3.5 7.1.2: the VRs with a 2-byte length; any other has 2 reserved
       // bytes and a 4-byte length.
       static const char* kShort[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FL", "FD", "IS", "LO",
