@@ -365,6 +365,36 @@ TEST(ImagingSegment, ACandidateMeasuredFromNearItsEdgeKeepsTheHeadsRim) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(ImagingSegment, ALagScrewsStreaksInsideTheHeadDoNotHideIt) {
+  // A lag screw along the neck into the head (0.9 x 0.9 x 2.5 mm voxels):
+  // its dark streaks, radial from the screw and so from the head's centre,
+  // end the rays along them 6-14 mm out, on more rays than reach the
+  // surface. The median edge then lay among them, the head's candidates
+  // never settled, and the search took the greater trochanter, 42 mm off.
+  // The sphere a quarter of the rays further out, on which many more rays
+  // agree, is now taken.
+  phantom::PhantomOptions o;
+  o.seed = 305;
+  o.model = geometry::ShapeModel::Superovoid;
+  o.head_radius_mm = 20;
+  o.spacing = Eigen::Vector3d(0.9, 0.9, 2.5);
+  o.gap_mm = 2.0;
+  o.exact_depth = true;
+  o.metal = phantom::PhantomOptions::Metal::Screw;
+  phantom::Phantom p = phantom::makePhantom(o);
+  const auto dir = testing::scratch("lag-screw");
+  imaging::writeVolume(dir / "ct.nii.gz", p.ct);  // int16, as `articula phantom` stores it
+  p.ct = imaging::readVolume(dir / "ct.nii.gz", {});
+  imaging::SegmentSummary s;
+  const imaging::Label label = imaging::segmentHead(p.ct, {}, &s);
+  const HeadCheck h = checkHead(p, label, s);
+  EXPECT_EQ(s.head_found_by, "edges");
+  EXPECT_LT(h.center_error_mm, 1.5);
+  EXPECT_NEAR(s.search_radius_mm, p.head.radii.mean(), 1.5);
+  EXPECT_GT(h.head_recall, 0.9);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ImagingSegment, SeedPointAndFailures) {
   const phantom::Phantom p = smallPhantom(4);
   imaging::SegmentOptions so;

@@ -58,7 +58,8 @@ Volume blockMean(const Volume& volume, const Eigen::Vector3i& factor) {
 
 /// Casts kRayCount rays (Fibonacci lattice) from `start`, takes the first
 /// bone edge on each (imaging/edges.hpp: full resolution, sub-voxel), and
-/// fits a sphere to the edges within a band of the median distance, twice
+/// fits a sphere to the edges within a band of the median distance (or of
+/// the first or third quartile, where many more edges agree), twice
 /// tightening the band; then once more from the fitted centre, so that the
 /// rays cross the head's surface nearly normally.
 /// Hand-written: ITK has no ray-cast edge detector; a sphere through edges
@@ -92,26 +93,53 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       distances.push_back(e.offset_mm);
     }
     if (distances.size() < 10) return unmeasured();
-    std::nth_element(distances.begin(), distances.begin() + static_cast<long>(distances.size() / 2), distances.end());
-    geometry::Sphere sphere{c.center, distances[distances.size() / 2]};
+    std::sort(distances.begin(), distances.end());
     const double voxel = volume.geometry.spacing.maxCoeff();
-    std::vector<char> inlier(edges.size(), 0);
-    for (double band_share : {0.12, 0.06, 0.04}) {
-      const double band = std::max({band_share * sphere.radius, 0.75 * voxel, 1.0});
-      std::vector<Eigen::Vector3d> kept;
-      for (size_t n = 0; n < edges.size(); ++n) {
-        inlier[n] = !std::isnan(edges[n][0]) && std::abs((edges[n] - sphere.center).norm() - sphere.radius) <= band;
-        if (inlier[n]) kept.push_back(edges[n]);
+    // The sphere of the edges within a band of `radius` about the ray
+    // origin, the band twice tightened about the sphere fitted to them.
+    struct Consensus {
+      geometry::Sphere sphere;
+      std::vector<char> inlier;
+      int count = 0;
+    };
+    const auto consensus = [&](double radius) -> std::optional<Consensus> {
+      Consensus fit{{c.center, radius}, std::vector<char>(edges.size(), 0), 0};
+      for (double band_share : {0.12, 0.06, 0.04}) {
+        const double band = std::max({band_share * fit.sphere.radius, 0.75 * voxel, 1.0});
+        std::vector<Eigen::Vector3d> kept;
+        for (size_t n = 0; n < edges.size(); ++n) {
+          fit.inlier[n] =
+              !std::isnan(edges[n][0]) && std::abs((edges[n] - fit.sphere.center).norm() - fit.sphere.radius) <= band;
+          if (fit.inlier[n]) kept.push_back(edges[n]);
+        }
+        if (kept.size() < 10) return std::nullopt;
+        Eigen::MatrixX3d points(static_cast<Eigen::Index>(kept.size()), 3);
+        for (size_t i = 0; i < kept.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = kept[i].transpose();
+        try {
+          fit.sphere = geometry::fitSphere(points);
+        } catch (const ProcessingError&) {
+          return std::nullopt;  // degenerate support (a flat or tiny patch): no head here
+        }
+        fit.count = static_cast<int>(kept.size());
       }
-      if (kept.size() < 10) return unmeasured();
-      Eigen::MatrixX3d points(static_cast<Eigen::Index>(kept.size()), 3);
-      for (size_t i = 0; i < kept.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = kept[i].transpose();
-      try {
-        sphere = geometry::fitSphere(points);
-      } catch (const ProcessingError&) {
-        return unmeasured();  // degenerate support (a flat or tiny patch): no head here
-      }
-    }
+      return fit;
+    };
+    const auto quantile = [&distances](double q) {
+      return distances[std::min(distances.size() - 1, static_cast<size_t>(q * double(distances.size())))];
+    };
+    std::optional<Consensus> best = consensus(quantile(0.5));
+    // Metal's streaks inside the head give edges short of its surface on
+    // the rays along them, which can outnumber the surface's: the median
+    // then lies among them, and a sphere of a head's size a quarter of the
+    // rays further out is taken where many more rays agree on it.
+    for (double q : {0.25, 0.75})
+      if (std::optional<Consensus> other = consensus(quantile(q));
+          other && other->sphere.radius >= r_lo && other->sphere.radius <= r_hi &&
+          (!best || other->count > kConsensusGain * best->count))
+        best = std::move(other);
+    if (!best) return unmeasured();
+    const geometry::Sphere& sphere = best->sphere;
+    const std::vector<char>& inlier = best->inlier;
     c.center = sphere.center;
     c.radius = sphere.radius;
     double sse = 0;

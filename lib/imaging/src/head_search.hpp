@@ -36,6 +36,9 @@ constexpr int kRayCount = 512;
 // Rays are cast again from each new centre, at most this often; a candidate
 // whose centre still moves is not measured.
 constexpr int kMaxRayRounds = 8;
+// A sphere started from another quantile of the rays' edge distances than
+// the median replaces the median's when this many times as many edges agree.
+constexpr double kConsensusGain = 1.5;
 
 /// A head measured from a point inside it: the sphere through the first bone
 /// edges seen on rays from that point, and the edges themselves.
