@@ -40,14 +40,14 @@ std::vector<double> dicomNumbers(const std::string& text) {
 
 namespace {
 
-// The groups of the elements GDCM reads to describe an image (identity and
-// modality, acquisition, position, pixels, dose grids, nuclear medicine),
-// each through a typed attribute that asserts, and aborts the process, when
-// the file's VR does not fit the dictionary's.
+// The groups of the elements GDCM reads to describe an image (the meta
+// header, identity and modality, acquisition, position, pixels, dose grids,
+// nuclear medicine), each through a typed attribute that asserts, and aborts
+// the process, when the file's VR does not fit the dictionary's.
 bool imageDescribingGroup(std::uint32_t tag) {
   const std::uint32_t group = tag >> 16;
-  return group == 0x0008 || group == 0x0018 || group == 0x0020 || group == 0x0028 || group == 0x0054 ||
-         group == 0x3004 || group == 0x5200;
+  return group == 0x0002 || group == 0x0008 || group == 0x0018 || group == 0x0020 || group == 0x0028 ||
+         group == 0x0054 || group == 0x3004 || group == 0x5200;
 }
 
 // The dictionary's VR (e.g. "US or SS") when an image-describing element's
