@@ -94,6 +94,33 @@ TEST(CapDepartures, AFlattenedDomeIsMeasuredInAreaAndDepth) {
   }
 }
 
+TEST(CapDepartures, ADomeLeftOutIsMeasuredWhenAChannelWithoutPointsJoinsItToTheNecksSide) {
+  // The dome flattened as above, its hole in the points joined to the part
+  // beyond the cap by a strip 12 degrees wide without points, down a
+  // meridian: as a selection's band, a few points off, can leave it. The
+  // dome is measured as it is without the channel, not taken for the neck's
+  // side and left unmeasured.
+  Case c;
+  const double h = 0.12 * kRadius, plane = kRadius - h;
+  for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v)
+    if (c.local(v).z() > plane) c.input.vertices(v, 2) = sphere().center.z() + plane;
+  c.choosePoints(plane - 0.5);
+  const CapDepartures closed = capDepartures(c.input);
+  ASSERT_EQ(closed.regions.size(), 1u);
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index i = 0; i < c.input.points.rows(); ++i) {
+    const Eigen::Vector3d x = c.input.points.row(i).transpose() - sphere().center;
+    if (!(x.x() > 0 && std::abs(std::atan2(x.y(), x.x())) < 6 * M_PI / 180)) kept.push_back(i);
+  }
+  ASSERT_LT(kept.size(), static_cast<size_t>(c.input.points.rows()));
+  const Eigen::MatrixX3d points = c.input.points(kept, Eigen::all);
+  c.input.points = points;
+  const CapDepartures channel = capDepartures(c.input);
+  ASSERT_EQ(channel.regions.size(), 1u);
+  EXPECT_EQ(channel.regions[0].kind, "inward");
+  EXPECT_NEAR(channel.regions[0].area_mm2, closed.regions[0].area_mm2, 0.05 * closed.regions[0].area_mm2);
+}
+
 TEST(CapDepartures, AnOsteophyteOnTheRimIsOutwardAndAPitAtTheMedialPoleIsTheFovea) {
   Case c;
   c.choosePoints(kRadius);

@@ -16,6 +16,7 @@ namespace {
 
 constexpr double kRimExtensionDeg = 15;   // osteophytes grow at the cap's margin, beyond its points
 constexpr int kCapDirections = 3000;     // about 3.7 degrees apart
+constexpr double kChannelDeg = 8;        // half the narrowest channel that joins a hole to the part beyond
 constexpr double kThresholdFloorMm = 0.75;
 constexpr double kFoveaMaxAngleDeg = 45;  // from the medial direction
 constexpr double kFoveaMaxAreaMm2 = 250, kFoveaMaxDepthMm = 5;
@@ -49,8 +50,9 @@ std::string anatomicalWords(const Eigen::Vector3d& d, const std::optional<Eigen:
 // The directions from the head's centre over its articular cap: a lattice
 // of directions, those holding a point's direction, and every hole they
 // enclose (a dome or a fovea the selection left out, gaps between sparse
-// points); beyond it, the largest part without points (the neck's side),
-// whose directions within kRimExtensionDeg of the cap are its rim.
+// points); beyond it, the largest part without points (the neck's side;
+// holes joined to it by a narrow channel stay holes), whose directions
+// within kRimExtensionDeg of the cap are its rim.
 struct CapDirections {
   static constexpr char kCap = 0, kRim = 1, kBeyond = 2;
   Eigen::MatrixX3d directions;
@@ -78,20 +80,35 @@ CapDirections capDirections(const Eigen::MatrixX3d& unit_points) {
       if (cosine(i, j) >= neighbour_cos) pairs.emplace_back(i, j, j);
   Eigen::MatrixX3i edges(static_cast<Eigen::Index>(pairs.size()), 3);
   for (size_t k = 0; k < pairs.size(); ++k) edges.row(static_cast<Eigen::Index>(k)) = pairs[k].transpose();
-  std::vector<char> empty(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) empty[static_cast<size_t>(i)] = !held[static_cast<size_t>(i)];
-  const std::vector<int> part = geometry::connectedParts(empty, edges);
+  // The part beyond is found among the directions at least kChannelDeg from
+  // every point, then grown back by as much over the directions without
+  // points: a hole that reaches it only through a channel narrower than
+  // that (a dome left out near the cap's margin) stays a hole of the cap,
+  // as it does where the points close it, instead of turning on a few
+  // points whether it is measured at all.
+  const double channel_cos = std::cos(kChannelDeg * M_PI / 180);
+  std::vector<char> far_from_points(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    bool far = !held[static_cast<size_t>(i)];
+    for (int j = 0; j < n && far; ++j) far = !(held[static_cast<size_t>(j)] && cosine(i, j) >= channel_cos);
+    far_from_points[static_cast<size_t>(i)] = far;
+  }
+  const std::vector<int> part = geometry::connectedParts(far_from_points, edges);
   std::vector<int> size(static_cast<size_t>(n), 0);
   for (int p : part)
     if (p >= 0) ++size[static_cast<size_t>(p)];
-  const int beyond = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  const int largest = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  std::vector<char> beyond(static_cast<size_t>(n), 0);
+  if (size[static_cast<size_t>(largest)] > 0)
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n && !held[static_cast<size_t>(i)] && !beyond[static_cast<size_t>(i)]; ++j)
+        beyond[static_cast<size_t>(i)] = part[static_cast<size_t>(j)] == largest && cosine(i, j) >= channel_cos;
   cap.place.assign(static_cast<size_t>(n), CapDirections::kCap);
   const double rim_cos = std::cos(kRimExtensionDeg * M_PI / 180);
   for (int i = 0; i < n; ++i) {
-    if (part[static_cast<size_t>(i)] != beyond || size[static_cast<size_t>(beyond)] == 0) continue;
+    if (!beyond[static_cast<size_t>(i)]) continue;
     bool near_cap = false;
-    for (int j = 0; j < n && !near_cap; ++j)
-      near_cap = part[static_cast<size_t>(j)] != beyond && cosine(i, j) >= rim_cos;
+    for (int j = 0; j < n && !near_cap; ++j) near_cap = !beyond[static_cast<size_t>(j)] && cosine(i, j) >= rim_cos;
     cap.place[static_cast<size_t>(i)] = near_cap ? CapDirections::kRim : CapDirections::kBeyond;
   }
   return cap;
