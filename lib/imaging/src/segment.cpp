@@ -336,8 +336,12 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
         box_raw.voxels[n] = 0, ++removed;
     log::debug("joint-gap valley: " + std::to_string(removed) + " voxels removed from the bone mask");
   }
+  // Cut again after the holes are filled: where noise has closed the soft
+  // tissue around the head into bone, the shell the first cut opened was a
+  // hole, and filling it gave it back.
   if (measured) cutBeyondEdges(box_raw, head_found);
-  const Mask box_mask = fillHoles(box_raw);
+  Mask box_mask = fillHoles(box_raw);
+  if (measured) cutBeyondEdges(box_mask, head_found);
   const ImageGeometry& bg = box_mask.geometry;
   const Image<float> box_distance = signedDistance(box_mask);
   // A seed point is only somewhere inside the head: re-centre on the deepest
