@@ -365,6 +365,21 @@ TEST(ImagingSegment, ACandidateMeasuredFromNearItsEdgeKeepsTheHeadsRim) {
   std::filesystem::remove_all(dir);
 }
 
+// A head of the clinical bench (bench/clinical.py's HEADS): its seed,
+// model, mean radius, side, voxels and joint gap, at exact widths.
+phantom::PhantomOptions clinicalHead(unsigned long long seed, geometry::ShapeModel model, double radius_mm, bool right,
+                                     const Eigen::Vector3d& spacing, double gap_mm) {
+  phantom::PhantomOptions o;
+  o.seed = seed;
+  o.model = model;
+  o.head_radius_mm = radius_mm;
+  o.right = right;
+  o.spacing = spacing;
+  o.gap_mm = gap_mm;
+  o.exact_depth = true;
+  return o;
+}
+
 TEST(ImagingSegment, ALagScrewsStreaksInsideTheHeadDoNotHideIt) {
   // A lag screw along the neck into the head (0.9 x 0.9 x 2.5 mm voxels):
   // its dark streaks, radial from the screw and so from the head's centre,
@@ -373,13 +388,8 @@ TEST(ImagingSegment, ALagScrewsStreaksInsideTheHeadDoNotHideIt) {
   // never settled, and the search took the greater trochanter, 42 mm off.
   // The sphere a quarter of the rays further out, on which many more rays
   // agree, is now taken.
-  phantom::PhantomOptions o;
-  o.seed = 305;
-  o.model = geometry::ShapeModel::Superovoid;
-  o.head_radius_mm = 20;
-  o.spacing = Eigen::Vector3d(0.9, 0.9, 2.5);
-  o.gap_mm = 2.0;
-  o.exact_depth = true;
+  phantom::PhantomOptions o =
+      clinicalHead(305, geometry::ShapeModel::Superovoid, 20, true, Eigen::Vector3d(0.9, 0.9, 2.5), 2.0);
   o.metal = phantom::PhantomOptions::Metal::Screw;
   phantom::Phantom p = phantom::makePhantom(o);
   const auto dir = testing::scratch("lag-screw");
@@ -401,14 +411,8 @@ TEST(ImagingSegment, LowDoseNoiseClosedAroundTheHeadIsCutOff) {
   // head's edges opens was a hole of the mask, and filling the holes gave
   // it back: the label reached the watershed's outer marker (1.35 radii) in
   // every direction, and the fit's radius came out 16-22 % large.
-  phantom::PhantomOptions o;
-  o.seed = 302;
-  o.model = geometry::ShapeModel::Ellipsoid;
-  o.head_radius_mm = 22;
-  o.right = false;
-  o.spacing = Eigen::Vector3d(0.8, 0.8, 1.5);
-  o.gap_mm = 2.5;
-  o.exact_depth = true;
+  phantom::PhantomOptions o =
+      clinicalHead(302, geometry::ShapeModel::Ellipsoid, 22, false, Eigen::Vector3d(0.8, 0.8, 1.5), 2.5);
   o.noise_hu = 100;
   const phantom::Phantom p = phantom::makePhantom(o);
   imaging::SegmentOptions so;
