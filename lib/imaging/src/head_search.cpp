@@ -238,6 +238,8 @@ class LatticeLookup {
   std::vector<int> nearest_;
 };
 
+}  // namespace
+
 /// The head's edge distance per lattice direction, with the holes of its cap
 /// (a missed edge, the fovea's pit) filled from their neighbours: a
 /// direction without an edge whose nearest neighbours mostly have one lies
@@ -281,17 +283,14 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
   return edge;
 }
 
-}  // namespace
-
 /// Removes from the bone mask what lies beyond the head's edge in the
 /// directions of its cap: the joint gap and the socket, however narrow the
 /// gap and whatever the closing bridged. The margin keeps the partial-volume
 /// voxels of the head's own edge (the mesh stage places the surface on the
 /// CT's edge within them).
-void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head) {
+void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head, const std::vector<double>& edge) {
   static const LatticeLookup lookup;
   const ImageGeometry& g = mask.geometry;
-  const std::vector<double> edge = capEdges(head, g.direction.col(2));
   const double margin = std::max(0.5, 0.5 * g.spacing.maxCoeff());
   long long removed = 0;
   for (int k = 0; k < g.size[2]; ++k)

@@ -78,7 +78,11 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
 /// space (acetabulum, glenoid); none when too little socket is seen or it
 /// leans to neither side.
 std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head, const SegmentOptions& options);
-/// Clears the mask's voxels beyond the head's edges in the directions of its cap.
-void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head);
+/// The head's edge distance per ray of the lattice, the holes of its cap
+/// filled from their neighbours (the neck's directions stay NaN);
+/// `slice_axis`: the grid's slice normal (unit, LPS).
+std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis);
+/// Clears the mask's voxels beyond the head's edges (capEdges) in the directions of its cap.
+void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head, const std::vector<double>& edge);
 
 }  // namespace articula::imaging::detail
