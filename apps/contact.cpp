@@ -148,7 +148,7 @@ class ContactCommand : public cli::Command {
     // (the same file for any thread count).
     std::vector<ContactResult> results(pairs.size());
     std::vector<double> row_ns(pairs.size(), 0.0);
-    parallelFor(static_cast<std::ptrdiff_t>(pairs.size()), 16, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    parallelFor(static_cast<std::ptrdiff_t>(pairs.size()), 16, common.threadCount(), [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (std::ptrdiff_t i = begin; i < end; ++i) {
         const contact::PairRow& pair = pairs[static_cast<size_t>(i)];
         if (!pair.valid) continue;
@@ -197,7 +197,7 @@ class ContactCommand : public cli::Command {
                               {"mean_iterations", static_cast<double>(iterations) / valid},
                               {"ns_per_query", median(ns)},
                               {"ns_per_query_note", "median over valid rows of the fastest of 5 identical calls; solver only, no file I/O"},
-                              {"threads", workerThreads()}};
+                              {"threads", common.threadCount()}};
     finish(summary, common, {pairs_});
     return 0;
   }
@@ -274,7 +274,7 @@ class ContactCommand : public cli::Command {
                                    {"step_tolerance", options_.step_tolerance},
                                    {"sample_directions", options_.sample_directions},
                                    {"global_starts", options_.global_starts}};
-    summary["provenance"] = provenanceJson({params, std::move(inputs), -1});
+    summary["provenance"] = provenanceJson({params, std::move(inputs), -1, common.threadCount()});
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);
     log::info("wrote " + output_.string());
     if (common.json) cli::printJson(summary);

@@ -124,7 +124,7 @@ class ErrorsCommand : public cli::Command {
     for (size_t m = 0; m < shapes.size(); ++m) {
       const std::string name = geometry::modelName(shapes[m].model);
       Eigen::VectorXd d;
-      distance::SignedDistance(shapes[m]).evaluate(P, d, feet, distance::SignedDistance::Start::WarmExact);
+      distance::SignedDistance(shapes[m], common.threadCount()).evaluate(P, d, feet, distance::SignedDistance::Start::WarmExact);
       all.col(static_cast<Eigen::Index>(m)) = d;
       rows.push_back(report::errorStatistics(name, d));
       series.push_back({name, d, rows.back().gauss_mu_mm, rows.back().gauss_sigma_mm});
@@ -141,7 +141,7 @@ class ErrorsCommand : public cli::Command {
     }
 
     nlohmann::json params = {{"fits", fits_.string()}, {"band_mm", given.band_mm}, {"resolution", given.resolution}};
-    const nlohmann::json provenance = provenanceJson({params, {input_, fits_}, -1});
+    const nlohmann::json provenance = provenanceJson({params, {input_, fits_}, -1, common.threadCount()});
     writeFileAtomically(output_ / "summary.csv", report::summaryCsv(rows), overwrite);
     std::vector<std::string> model_names;
     for (const auto& shape : shapes) model_names.push_back(geometry::modelName(shape.model));

@@ -64,6 +64,7 @@ class FitCommand : public cli::Command {
     o.max_evaluations = given.max_evaluations;
     o.sample_points = given.sample_points;
     o.seed = static_cast<unsigned>(common.seed);
+    o.threads = common.threadCount();
     if (!given.bounds.empty()) o.bounds = readBounds(given.bounds);
     if (!grid_.empty()) {
       const imaging::ImageGeometry grid = imaging::readImageGeometry(grid_);
@@ -91,7 +92,7 @@ class FitCommand : public cli::Command {
     if (!given.bounds.empty()) inputs.push_back(given.bounds);
     if (!grid_.empty()) inputs.push_back(grid_);
     const nlohmann::json doc = fit::fitsDocument(summary, input_.string(), given.objective,
-                                                 provenanceJson({params, inputs, common.seed}));
+                                                 provenanceJson({params, inputs, common.seed, o.threads}));
     writeFileAtomically(output_, doc.dump(2) + "\n", common.force);
     writeFileAtomically(csv, fit::fitsCsv(summary), common.force);
     if (common.json)

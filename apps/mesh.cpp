@@ -45,6 +45,7 @@ class MeshCommand : public cli::Command {
     snap.edge_model = given.edge_model == "cortex"     ? mesh::EdgeModel::Cortex
                        : given.edge_model == "steepest" ? mesh::EdgeModel::SteepestFall
                                                    : mesh::EdgeModel::Automatic;
+    snap.threads = common.threadCount();
     snap.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
     checkOutputTarget(output_);
@@ -55,7 +56,7 @@ class MeshCommand : public cli::Command {
     if (!ct_.empty()) {
       imaging::ReadOptions read;
       read.series_uid = given.series_uid;
-      const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(ct_, read);
+      const std::shared_ptr<const imaging::Volume> ct = imaging::readSharedVolume(ct_, read, nullptr, common.memory);
       mesh::EdgeSnapSummary snapped;
       mesh::snapToEdges(m, *ct, snap, &snapped);
       const double share = snapped.vertices ? static_cast<double>(snapped.on_edge) / snapped.vertices : 0.0;
@@ -100,7 +101,7 @@ class MeshCommand : public cli::Command {
                               {"provenance", provenanceJson({params, ct_.empty() || std::filesystem::is_directory(ct_)
                                                                           ? std::vector<std::filesystem::path>{input_}
                                                                           : std::vector<std::filesystem::path>{input_, ct_},
-                                                                      -1})}};
+                                                                      -1, common.threadCount()})}};
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);
     if (common.json) cli::printJson(summary);
     return 0;

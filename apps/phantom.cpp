@@ -170,7 +170,7 @@ class PhantomCommand : public cli::Command {
     nlohmann::json truth = p.truth;
     truth["files"] = {{"nifti", "phantom.nii.gz"}, {"femur_label", "femur_truth.nii.gz"}};
     if (!no_dicom_) truth["files"]["dicom"] = "dicom";
-    truth["provenance"] = provenanceJson({truth["parameters"], {}, common.seed});
+    truth["provenance"] = provenanceJson({truth["parameters"], {}, common.seed, common.threadCount()});
     writeFileAtomically(output_ / "truth.json", truth.dump(2) + "\n", true);
     if (common.json) cli::printJson(truth);
     return 0;

@@ -40,6 +40,7 @@ class ReportCommand : public cli::Command {
       existing.push_back(options_.folder / file);
     cli::refuseExistingOutputs(existing, common.force);
     options_.seed = common.seed;
+    options_.memory = common.memory;
     const checks::QcReport qc = subject::writeSubjectReport(options_);
     for (const std::string& reason : qc.reasons()) log::warn("qc " + reason);
     if (qc.status == "fail") {

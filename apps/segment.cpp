@@ -53,7 +53,7 @@ class SegmentCommand : public cli::Command {
     imaging::ReadOptions read;
     read.series_uid = given.series_uid;
     imaging::ReadReport report;
-    const std::shared_ptr<const imaging::Volume> shared_ct = imaging::readSharedVolume(input_, read, &report);
+    const std::shared_ptr<const imaging::Volume> shared_ct = imaging::readSharedVolume(input_, read, &report, common.memory);
     std::optional<imaging::Volume> labelled_bone;
     if (!given.label.empty()) {
       labelled_bone = imaging::keepLabelledBone(*shared_ct, given.label, given.label_value ? std::optional<int>(given.label_value) : std::nullopt);
@@ -117,7 +117,7 @@ class SegmentCommand : public cli::Command {
         {"threshold_voxels", s.threshold_voxels},
         {"label_voxels", s.label_voxels},
         {"warnings", warnings},
-        {"provenance", provenanceJson({params, inputs, -1})}};
+        {"provenance", provenanceJson({params, inputs, -1, common.threadCount()})}};
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);
     if (common.json) cli::printJson(summary);
     return 0;

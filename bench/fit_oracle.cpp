@@ -24,7 +24,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include "articula/core/parallel.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/testsupport/run_all.hpp"
 #include "articula/testsupport/synthetic_cap.hpp"
@@ -74,7 +73,6 @@ int main(int argc, char** argv) {
   app.add_option("--jobs", jobs, "Caps fitted at once (each on one thread)")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "Base seed of every case");
   CLI11_PARSE(app, argc, argv);
-  articula::setWorkerThreads(1);
 
   const ShapeModel families[] = {ShapeModel::Superellipsoid, ShapeModel::Ovoid, ShapeModel::Superovoid};
   std::vector<Case> all;

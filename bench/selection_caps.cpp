@@ -29,7 +29,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "articula/core/parallel.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/shape.hpp"
@@ -52,7 +51,6 @@ int main(int argc, char** argv) {
   std::string only;
   app.add_option("--true", only, "Only caps of this true model (their seeds unchanged)");
   CLI11_PARSE(app, argc, argv);
-  articula::setWorkerThreads(1);
 
   const auto& models = articula::geometry::allModels();
   const int total = caps * static_cast<int>(models.size());

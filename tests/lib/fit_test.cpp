@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
-#include "articula/core/parallel.hpp"
 #include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/algebraic_fit.hpp"
 #include "articula/fit/fit_hierarchy.hpp"
@@ -269,11 +268,10 @@ TEST(FitHierarchy, DeterministicForAFixedSeed) {
   o.global_evaluations = 300;
   o.seed = 9;
   // The starts are screened over the threads: one thread or four, the same fits.
-  articula::setWorkerThreads(1);
+  o.threads = 1;
   const Summary a = articula::fit::fitHierarchy(pts, o);
-  articula::setWorkerThreads(4);
+  o.threads = 4;
   const Summary b = articula::fit::fitHierarchy(pts, o);
-  articula::setWorkerThreads(0);
   for (size_t i = 0; i < a.fits.size(); ++i) {
     EXPECT_EQ(articula::geometry::toVector(a.fits[i].parameters), articula::geometry::toVector(b.fits[i].parameters));
     EXPECT_EQ(a.fits[i].evaluations, b.fits[i].evaluations);
@@ -292,6 +290,7 @@ TEST(FitHierarchy, SampleThenAllPointsReachesTheFullOptimum) {
   all.models = {ShapeModel::Sphere, ShapeModel::Ellipsoid, ShapeModel::Superellipsoid};
   Options sampled = all;
   sampled.sample_points = 2000;
+  sampled.threads = 4;  // against one thread below
   const Summary full = articula::fit::fitHierarchy(pts, all);
   const Summary part = articula::fit::fitHierarchy(pts, sampled);
   ASSERT_EQ(full.fits.size(), part.fits.size());
@@ -308,9 +307,9 @@ TEST(FitHierarchy, SampleThenAllPointsReachesTheFullOptimum) {
                                 articula::distance::signedDistances(f.parameters, pts);
     EXPECT_LT(gap.cwiseAbs().maxCoeff(), 0.01) << model;
   }
-  articula::setWorkerThreads(1);
-  const Summary one_thread = articula::fit::fitHierarchy(pts, sampled);
-  articula::setWorkerThreads(0);
+  Options one = sampled;
+  one.threads = 1;
+  const Summary one_thread = articula::fit::fitHierarchy(pts, one);
   for (size_t i = 0; i < part.fits.size(); ++i)
     EXPECT_EQ(articula::geometry::toVector(one_thread.fits[i].parameters), articula::geometry::toVector(part.fits[i].parameters));
 }

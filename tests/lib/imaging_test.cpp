@@ -55,39 +55,39 @@ TEST(ImagingIo, NiftiRoundTripKeepsLpsGeometryEvenWhenStoredRas) {
   }
 }
 
-// A volume read again while a VolumeMemory is alive comes from memory, the
-// same voxels; a file changed since (size or time) is read anew; without a
-// memory every read goes to the file.
-TEST(ImagingIo, VolumeMemoryAnswersARepeatedReadUntilTheFileChanges) {
+// A volume read again with a run's memory comes from memory, the same
+// voxels, not a copy; other options or a file changed since (size or time)
+// are read anew; without a memory every read goes to the file, and two
+// memories keep their own.
+TEST(ImagingIo, RunMemoryAnswersARepeatedReadUntilTheFileChanges) {
   const phantom::Phantom p = smallPhantom(5);
   const auto dir = testing::scratch("memory");
   imaging::writeVolume(dir / "ct.nii.gz", p.ct);
-  {
-    const imaging::VolumeMemory memory;
-    const imaging::Volume first = imaging::readVolume(dir / "ct.nii.gz", {});
-    const imaging::Volume again = imaging::readVolume(dir / "ct.nii.gz", {});
-    EXPECT_EQ(memory.hits(), 1);
-    EXPECT_EQ(first.voxels, again.voxels);
-    // Shared reads hand out the kept volume itself, not a copy.
-    EXPECT_EQ(imaging::readSharedVolume(dir / "ct.nii.gz", {}), imaging::readSharedVolume(dir / "ct.nii.gz", {}));
-    EXPECT_EQ(memory.hits(), 3);
-    imaging::ReadOptions other;
-    other.spacing_tolerance = 0.02;
-    imaging::readVolume(dir / "ct.nii.gz", other);  // other options: another read
-    EXPECT_EQ(memory.hits(), 3);
-    imaging::Volume changed = p.ct;
-    for (float& v : changed.voxels) v += 100;
-    imaging::writeVolume(dir / "ct.nii.gz", changed);
-    std::filesystem::last_write_time(dir / "ct.nii.gz", std::filesystem::last_write_time(dir / "ct.nii.gz") +
-                                                            std::chrono::seconds(2));
-    const imaging::Volume reread = imaging::readVolume(dir / "ct.nii.gz", other);
-    EXPECT_EQ(memory.hits(), 3);
-    EXPECT_NEAR(reread.voxels[0], first.voxels[0] + 100, 0.5);
-    EXPECT_THROW(imaging::VolumeMemory second, ProcessingError);  // one at a time
-  }
-  const imaging::VolumeMemory fresh;
-  imaging::readVolume(dir / "ct.nii.gz", {});
+  RunMemory memory;
+  const auto first = imaging::readSharedVolume(dir / "ct.nii.gz", {}, nullptr, &memory);
+  const auto again = imaging::readSharedVolume(dir / "ct.nii.gz", {}, nullptr, &memory);
+  EXPECT_EQ(memory.hits(), 1);
+  EXPECT_EQ(first, again);  // the kept volume itself
+  const float first_voxel = first->voxels[0];
+  imaging::ReadOptions other;
+  other.spacing_tolerance = 0.02;
+  const auto with_other = imaging::readSharedVolume(dir / "ct.nii.gz", other, nullptr, &memory);
+  EXPECT_NE(with_other, first);  // other options: another read
+  EXPECT_EQ(memory.hits(), 1);
+  imaging::Volume changed = p.ct;
+  for (float& v : changed.voxels) v += 100;
+  imaging::writeVolume(dir / "ct.nii.gz", changed);
+  std::filesystem::last_write_time(dir / "ct.nii.gz", std::filesystem::last_write_time(dir / "ct.nii.gz") +
+                                                          std::chrono::seconds(2));
+  const auto reread = imaging::readSharedVolume(dir / "ct.nii.gz", other, nullptr, &memory);
+  EXPECT_EQ(memory.hits(), 1);
+  EXPECT_NEAR(reread->voxels[0], first_voxel + 100, 0.5);
+  EXPECT_EQ(first->voxels[0], first_voxel);  // a volume handed out earlier stays as it was
+  RunMemory fresh;
+  imaging::readSharedVolume(dir / "ct.nii.gz", other, nullptr, &fresh);
   EXPECT_EQ(fresh.hits(), 0);
+  const auto alone = imaging::readSharedVolume(dir / "ct.nii.gz", {}), alone_again = imaging::readSharedVolume(dir / "ct.nii.gz", {});
+  EXPECT_NE(alone, alone_again);  // without a memory, each read its own
   std::filesystem::remove_all(dir);
 }
 

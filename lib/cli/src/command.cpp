@@ -16,7 +16,7 @@
 
 namespace articula::cli {
 
-int CommonOptions::threadCount() const { return threads > 0 ? threads : workerThreads(); }
+int CommonOptions::threadCount() const { return resolveThreads(threads); }
 
 namespace {
 
@@ -103,7 +103,6 @@ int guarded(Body&& body) {
 
 void applyCommon(const CommonOptions& common) {
   log::setLevel(static_cast<log::Level>(common.verbosity));
-  setWorkerThreads(common.threads);
 }
 
 // CLI11 reports usage errors itself; normalise its exit codes to ours.
@@ -121,11 +120,13 @@ void describe(CLI::App& app, const Command& command) {
 }  // namespace
 
 namespace {
-int runSingle(int argc, char** argv, const std::string& program, std::unique_ptr<Command> command) {
+int runSingle(int argc, char** argv, const std::string& program, std::unique_ptr<Command> command,
+              RunMemory* memory = nullptr) {
   CLI::App app;
   app.name(program);
   describe(app, *command);
   CommonOptions common;
+  common.memory = memory;
   addCommonOptions(app, common);
   command->declare(app);
   try {
@@ -177,7 +178,7 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
   return static_cast<int>(ExitCode::UsageError);
 }
 
-int runCommandInProcess(const std::string& name, const std::vector<std::string>& args) {
+int runCommandInProcess(const std::string& name, const std::vector<std::string>& args, RunMemory* memory) {
   std::vector<std::string> full = {"articula " + name};
   full.insert(full.end(), args.begin(), args.end());
   std::vector<char*> argv;
@@ -189,7 +190,7 @@ int runCommandInProcess(const std::string& name, const std::vector<std::string>&
   setCommandLine(static_cast<int>(shown.size()), shown.data());
   const std::string outer_invoker = invokingCommand();
   setInvokingCommand(outer_invoker.empty() ? outer : outer_invoker);
-  const int rc = runSingle(static_cast<int>(full.size()), argv.data(), full[0], createCommand(name));
+  const int rc = runSingle(static_cast<int>(full.size()), argv.data(), full[0], createCommand(name), memory);
   setInvokingCommand(outer_invoker);
   setCommandLineString(outer);
   return rc;

@@ -6,7 +6,6 @@
 #include <memory>
 
 #include "articula/core/error.hpp"
-#include "articula/core/parallel.hpp"
 #include "articula/core/version.hpp"
 
 namespace articula {
@@ -82,7 +81,7 @@ nlohmann::json provenanceJson(const Provenance& p) {
                       {"command", commandLine()},
                       {"parameters", p.parameters},
                       {"inputs", inputs},
-                      {"threads", workerThreads()},
+                      {"threads", p.threads},
                       {"coordinate_system", "LPS"},
                       {"units", "mm"}};
   if (p.seed >= 0) j["seed"] = p.seed;

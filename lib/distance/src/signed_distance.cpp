@@ -32,8 +32,8 @@ constexpr Eigen::Index kGroup = 6;  // triangles per bounding run
 bool isQuadric(ShapeModel m) { return m == ShapeModel::Sphere || m == ShapeModel::Ellipsoid; }
 }  // namespace
 
-SignedDistance::SignedDistance(const geometry::ShapeParameters& shape)
-    : shape_(shape), surface_(geometry::makeSurface(shape)), pose_(surface_->pose()), rotation_(pose_.rotation) {}
+SignedDistance::SignedDistance(const geometry::ShapeParameters& shape, int threads)
+    : shape_(shape), threads_(resolveThreads(threads)), surface_(geometry::makeSurface(shape)), pose_(surface_->pose()), rotation_(pose_.rotation) {}
 
 void SignedDistance::buildSeeds() const {
   // Seeds: an exact parametric sample of the surface, and the longest edge
@@ -371,8 +371,8 @@ void SignedDistance::evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d
   }
   // The seeds are built lazily by closest(); once, before threads share them.
   constexpr Eigen::Index kChunk = 2048;
-  if (n >= 2 * kChunk && workerThreads() > 1 && !isQuadric(shape_.model) && seeds_.rows() == 0) buildSeeds();
-  parallelFor(n, kChunk, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+  if (n >= 2 * kChunk && threads_ > 1 && !isQuadric(shape_.model) && seeds_.rows() == 0) buildSeeds();
+  parallelFor(n, kChunk, threads_, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       const Vector3d x = points.row(i).transpose();
       const ClosestPoint c = start == Start::Warm        ? closestFrom(x, feet.row(i).transpose())
@@ -384,10 +384,10 @@ void SignedDistance::evaluate(const Eigen::MatrixX3d& points, Eigen::VectorXd& d
   });
 }
 
-Eigen::VectorXd signedDistances(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points) {
+Eigen::VectorXd signedDistances(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points, int threads) {
   Eigen::VectorXd d;
   Eigen::MatrixX3d feet;
-  SignedDistance(shape).evaluate(points, d, feet);
+  SignedDistance(shape, threads).evaluate(points, d, feet);
   return d;
 }
 

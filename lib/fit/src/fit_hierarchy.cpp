@@ -91,8 +91,8 @@ double algebraicObjective(const ShapeParameters& shape, const Eigen::MatrixX3d& 
   return sum;
 }
 
-double geometricObjective(const ShapeParameters& shape, const Eigen::MatrixX3d& points) {
-  return distance::signedDistances(shape, points).squaredNorm();
+double geometricObjective(const ShapeParameters& shape, const Eigen::MatrixX3d& points, int threads) {
+  return distance::signedDistances(shape, points, threads).squaredNorm();
 }
 
 namespace {
@@ -182,13 +182,13 @@ VectorXd initialSteps(ShapeModel model, const ShapeParameters& start) {
 // d_i (geometric; `feet` are warm starts on entry, closest points on exit).
 // Throws InvalidParameter outside the valid set.
 void residuals(const ShapeParameters& p, Objective kind, const Eigen::MatrixX3d& points, VectorXd& r,
-               Eigen::MatrixX3d& feet) {
+               Eigen::MatrixX3d& feet, int threads) {
   if (kind == Objective::Algebraic) {
     const auto surface = geometry::makeSurface(p);
     r.resize(points.rows());
     for (Eigen::Index i = 0; i < points.rows(); ++i) r[i] = surface->value(points.row(i).transpose());
   } else {
-    distance::SignedDistance(p).evaluate(points, r, feet, feet.rows() == points.rows());
+    distance::SignedDistance(p, threads).evaluate(points, r, feet, feet.rows() == points.rows());
   }
 }
 
@@ -196,13 +196,13 @@ void residuals(const ShapeParameters& p, Objective kind, const Eigen::MatrixX3d&
 // distances, dF/dlambda / |grad F| at the closest points `feet` (the envelope
 // theorem; orthogonal distance fitting, Ahn 2004).
 Eigen::MatrixXd residualJacobian(const ShapeParameters& p, Objective kind, const Eigen::MatrixX3d& points,
-                                 const Eigen::MatrixX3d& feet) {
+                                 const Eigen::MatrixX3d& feet, int threads) {
   Eigen::MatrixXd J;
   VectorXd norms;
   if (kind == Objective::Algebraic) {
-    parameterGradient(p, points, J, norms);
+    parameterGradient(p, points, J, norms, threads);
   } else {
-    parameterGradient(p, feet, J, norms);
+    parameterGradient(p, feet, J, norms, threads);
     J.array().colwise() /= norms.array();
   }
   return J;
@@ -213,8 +213,8 @@ Eigen::MatrixXd residualJacobian(const ShapeParameters& p, Objective kind, const
 // (`feet`: those of the start, if known; else empty).
 class ResidualProblem : public LeastSquaresProblem {
  public:
-  ResidualProblem(ShapeModel model, const Eigen::MatrixX3d& points, Objective kind, Eigen::MatrixX3d feet)
-      : model_(model), points_(points), kind_(kind), feet_(std::move(feet)) {}
+  ResidualProblem(ShapeModel model, const Eigen::MatrixX3d& points, Objective kind, Eigen::MatrixX3d feet, int threads)
+      : model_(model), points_(points), kind_(kind), threads_(threads), feet_(std::move(feet)) {}
 
   const Eigen::MatrixX3d& feet() const { return feet_; }
 
@@ -222,7 +222,7 @@ class ResidualProblem : public LeastSquaresProblem {
     try {
       trial_ = geometry::fromVector(model_, x);
       trial_feet_ = feet_;
-      residuals(trial_, kind_, points_, r, trial_feet_);
+      residuals(trial_, kind_, points_, r, trial_feet_, threads_);
       return true;
     } catch (const InvalidParameter&) {
       return false;  // e.g. an ovoid denominator reaching 0 on [-1, 1]
@@ -231,13 +231,14 @@ class ResidualProblem : public LeastSquaresProblem {
 
   void accept(Eigen::MatrixXd& J) override {
     feet_.swap(trial_feet_);
-    J = residualJacobian(trial_, kind_, points_, feet_);
+    J = residualJacobian(trial_, kind_, points_, feet_, threads_);
   }
 
  private:
   ShapeModel model_;
   const Eigen::MatrixX3d& points_;
   Objective kind_;
+  int threads_;
   Eigen::MatrixX3d feet_, trial_feet_;
   ShapeParameters trial_;
 };
@@ -248,8 +249,8 @@ class ResidualProblem : public LeastSquaresProblem {
 class ObjectiveFunction {
  public:
   ObjectiveFunction(ShapeModel model, const Eigen::MatrixX3d& points, Objective kind, VectorXd origin, VectorXd scale,
-                    Eigen::MatrixX3d feet)
-      : model_(model), points_(points), kind_(kind), origin_(std::move(origin)), scale_(std::move(scale)),
+                    Eigen::MatrixX3d feet, int threads)
+      : model_(model), points_(points), kind_(kind), threads_(threads), origin_(std::move(origin)), scale_(std::move(scale)),
         best_feet_(std::move(feet)) {}
 
   const Eigen::MatrixX3d& bestFeet() const { return best_feet_; }
@@ -265,7 +266,7 @@ class ObjectiveFunction {
     try {
       const ShapeParameters p = geometry::fromVector(model_, lambda);
       feet_ = best_feet_;
-      residuals(p, kind_, points_, d_, feet_);
+      residuals(p, kind_, points_, d_, feet_, threads_);
       f = d_.squaredNorm();
       if (!grad.empty()) gradient(p, grad);
     } catch (const InvalidParameter&) {
@@ -292,13 +293,14 @@ class ObjectiveFunction {
 
  private:
   void gradient(const ShapeParameters& p, std::vector<double>& grad) const {
-    const VectorXd g = 2.0 * (residualJacobian(p, kind_, points_, feet_).transpose() * d_).cwiseProduct(scale_);
+    const VectorXd g = 2.0 * (residualJacobian(p, kind_, points_, feet_, threads_).transpose() * d_).cwiseProduct(scale_);
     std::copy(g.data(), g.data() + g.size(), grad.begin());
   }
 
   ShapeModel model_;
   const Eigen::MatrixX3d& points_;
   Objective kind_;
+  int threads_;
   VectorXd origin_, scale_;
   VectorXd d_;
   Eigen::MatrixX3d feet_, best_feet_;
@@ -345,7 +347,7 @@ RunResult runNlopt(nlopt::algorithm algorithm, ShapeModel model, const VectorXd&
                    const VectorXd& steps, int max_evaluations, const Eigen::MatrixX3d& points,
                    const Eigen::MatrixX3d& feet, const Options& o) {
   const unsigned n = static_cast<unsigned>(start.size());
-  ObjectiveFunction objective(model, points, o.objective, start, steps, feet);
+  ObjectiveFunction objective(model, points, o.objective, start, steps, feet, o.threads);
   std::vector<double> x(n, 0.0), no_gradient;
   objective(x, no_gradient);  // the start is always a candidate
   const VectorXd lower = (bounds.lower - start).cwiseQuotient(steps);
@@ -385,7 +387,7 @@ RunResult runNlopt(nlopt::algorithm algorithm, ShapeModel model, const VectorXd&
 // Levenberg-Marquardt on the residuals from `start` within `bounds`.
 RunResult runLevenbergMarquardt(ShapeModel model, const VectorXd& start, const Bounds& bounds, int max_evaluations,
                                 const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& feet, const Options& o) {
-  ResidualProblem problem(model, points, o.objective, feet);
+  ResidualProblem problem(model, points, o.objective, feet, o.threads);
   LeastSquaresOptions lm;
   lm.max_evaluations = max_evaluations;
   lm.relative_tolerance = o.relative_tolerance;
@@ -493,9 +495,10 @@ ShapeParameters wrapAngles(ShapeParameters p) {
 // `feet`), whatever the objective: what is reported and nested. `feet` on
 // entry: closest points on a nearby surface, if known, that spare most global
 // searches without making the result any less exact.
-double exactRms(const ShapeParameters& p, const Eigen::MatrixX3d& points, double& sse, Eigen::MatrixX3d& feet) {
+double exactRms(const ShapeParameters& p, const Eigen::MatrixX3d& points, double& sse, Eigen::MatrixX3d& feet,
+                int threads) {
   VectorXd d;
-  distance::SignedDistance(p).evaluate(points, d, feet, distance::SignedDistance::Start::WarmExact);
+  distance::SignedDistance(p, threads).evaluate(points, d, feet, distance::SignedDistance::Start::WarmExact);
   sse = d.squaredNorm();
   return std::sqrt(sse / static_cast<double>(points.rows()));
 }
@@ -546,7 +549,7 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
     // The starts are independent: screened side by side over --threads, then
     // taken in their order (the same answer for any thread count).
     std::vector<RunResult> runs(starts.size());
-    parallelFor(static_cast<std::ptrdiff_t>(starts.size()), 1, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    parallelFor(static_cast<std::ptrdiff_t>(starts.size()), 1, o.threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (std::ptrdiff_t i = begin; i < end; ++i) {
         const Start& start = starts[static_cast<size_t>(i)];
         const auto [x0, b] = prepareStart(model, start.shape, model_bounds);
@@ -622,7 +625,7 @@ Fitted fitModel(ShapeModel model, std::vector<Start> starts, const Bounds& model
     for (const Start& s : starts) all += (all.empty() ? "" : ",") + s.label;
     best.started_from += " (best of " + all + ")";
   }
-  best.rms_mm = exactRms(best.parameters, points, best.sse_mm2, fitted.feet);
+  best.rms_mm = exactRms(best.parameters, points, best.sse_mm2, fitted.feet, o.threads);
   best.algebraic_objective = algebraicObjective(best.parameters, points);
   best.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return fitted;
@@ -697,7 +700,8 @@ ShapeParameters combineParents(const ShapeParameters& superellipsoid, const Shap
 // The nesting guarantee: a child never reports a worse RMS than its parent.
 // Not where the user's bounds exclude the parent (then the child answers
 // within them, even if the parent fits better).
-void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::MatrixX3d& points, const Bounds& bounds) {
+void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::MatrixX3d& points, const Bounds& bounds,
+                    int threads) {
   ModelFit& child = fitted.fit;
   const ModelFit& parent = parent_fitted.fit;
   if (child.rms_mm <= parent.rms_mm) return;
@@ -707,7 +711,7 @@ void enforceNesting(Fitted& fitted, const Fitted& parent_fitted, const Eigen::Ma
     if (bounds.given[static_cast<size_t>(i)] && !(promoted[i] >= bounds.lower[i] && promoted[i] <= bounds.upper[i])) return;
   child.parameters = geometry::promote(parent.parameters, model);
   fitted.feet = parent_fitted.feet;
-  child.rms_mm = exactRms(child.parameters, points, child.sse_mm2, fitted.feet);
+  child.rms_mm = exactRms(child.parameters, points, child.sse_mm2, fitted.feet, threads);
   child.algebraic_objective = algebraicObjective(child.parameters, points);
   child.termination += "; kept the " + geometry::modelName(parent.parameters.model) + " (fit was not better)";
 }
@@ -785,7 +789,7 @@ HierarchyFits fitAll(const Eigen::MatrixX3d& points, const AlgebraicStarts& a, c
   if (a.have_ellipsoid) e_starts.push_back({"algebraic", a.ellipsoid, {}});
   h.ellipsoid =
       fitModel(ShapeModel::Ellipsoid, e_starts, bounds(ShapeModel::Ellipsoid), points, o, o.screening_evaluations);
-  enforceNesting(h.ellipsoid, h.sphere, points, bounds(ShapeModel::Ellipsoid));
+  enforceNesting(h.ellipsoid, h.sphere, points, bounds(ShapeModel::Ellipsoid), o.threads);
   reportModel(h.ellipsoid, long_run);
 
   const bool need_se = wanted(o, ShapeModel::Superellipsoid) || wanted(o, ShapeModel::Superovoid);
@@ -793,13 +797,13 @@ HierarchyFits fitAll(const Eigen::MatrixX3d& points, const AlgebraicStarts& a, c
   if (need_se) {
     h.superellipsoid = fitModel(ShapeModel::Superellipsoid, superellipsoidStarts(h.ellipsoid),
                                 bounds(ShapeModel::Superellipsoid), points, o, o.screening_evaluations);
-    enforceNesting(h.superellipsoid, h.ellipsoid, points, bounds(ShapeModel::Superellipsoid));
+    enforceNesting(h.superellipsoid, h.ellipsoid, points, bounds(ShapeModel::Superellipsoid), o.threads);
     reportModel(h.superellipsoid, long_run);
   }
   if (need_o) {
     h.ovoid = fitModel(ShapeModel::Ovoid, axisLabellings(h.ellipsoid), bounds(ShapeModel::Ovoid), points, o,
                        o.screening_evaluations);
-    enforceNesting(h.ovoid, h.ellipsoid, points, bounds(ShapeModel::Ovoid));
+    enforceNesting(h.ovoid, h.ellipsoid, points, bounds(ShapeModel::Ovoid), o.threads);
     reportModel(h.ovoid, long_run);
   }
   if (wanted(o, ShapeModel::Superovoid)) {
@@ -812,7 +816,7 @@ HierarchyFits fitAll(const Eigen::MatrixX3d& points, const AlgebraicStarts& a, c
     h.superovoid = fitModel(ShapeModel::Superovoid, so_starts, bounds(ShapeModel::Superovoid), points, o,
                             o.screening_evaluations);
     enforceNesting(h.superovoid, h.superellipsoid.fit.rms_mm <= h.ovoid.fit.rms_mm ? h.superellipsoid : h.ovoid,
-                   points, bounds(ShapeModel::Superovoid));
+                   points, bounds(ShapeModel::Superovoid), o.threads);
     reportModel(h.superovoid, long_run);
   }
   return h;
@@ -869,15 +873,15 @@ HierarchyFits refineAll(const HierarchyFits& on_sample, const Eigen::MatrixX3d& 
   HierarchyFits h;
   h.sphere = refine(on_sample.sphere, nullptr);
   h.ellipsoid = refine(on_sample.ellipsoid, &h.sphere);
-  enforceNesting(h.ellipsoid, h.sphere, points, bounds(ShapeModel::Ellipsoid));
+  enforceNesting(h.ellipsoid, h.sphere, points, bounds(ShapeModel::Ellipsoid), o.threads);
   h.superellipsoid = refine(on_sample.superellipsoid, &h.ellipsoid);
   if (h.superellipsoid.fit.evaluations > 0)
-    enforceNesting(h.superellipsoid, h.ellipsoid, points, bounds(ShapeModel::Superellipsoid));
+    enforceNesting(h.superellipsoid, h.ellipsoid, points, bounds(ShapeModel::Superellipsoid), o.threads);
   h.ovoid = refine(on_sample.ovoid, &h.ellipsoid);
-  if (h.ovoid.fit.evaluations > 0) enforceNesting(h.ovoid, h.ellipsoid, points, bounds(ShapeModel::Ovoid));
+  if (h.ovoid.fit.evaluations > 0) enforceNesting(h.ovoid, h.ellipsoid, points, bounds(ShapeModel::Ovoid), o.threads);
   const Fitted& so_parent = h.superellipsoid.fit.rms_mm <= h.ovoid.fit.rms_mm ? h.superellipsoid : h.ovoid;
   h.superovoid = refine(on_sample.superovoid, &so_parent);
-  if (h.superovoid.fit.evaluations > 0) enforceNesting(h.superovoid, so_parent, points, bounds(ShapeModel::Superovoid));
+  if (h.superovoid.fit.evaluations > 0) enforceNesting(h.superovoid, so_parent, points, bounds(ShapeModel::Superovoid), o.threads);
   return h;
 }
 
@@ -888,7 +892,7 @@ ModelFit fitFrom(const ShapeParameters& start, const Eigen::MatrixX3d& points, c
   const AlgebraicStarts a = algebraicStarts(points);
   const Bounds b = makeBounds(start.model, a.ellipsoid, a.sphere, o);
   Fitted f = fitModel(start.model, {{"given start", start, {}}}, b, points, o);
-  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty, o.edge_offset);
+  f.fit.uncertainty = parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty, o.edge_offset, o.threads);
   return f.fit;
 }
 
@@ -931,7 +935,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   for (const Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid})
     if (wanted(o, f->fit.parameters.model) && f->fit.evaluations > 0) {
       summary.fits.push_back(f->fit);
-      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty, o.edge_offset);
+      summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty, o.edge_offset, o.threads);
     }
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)

@@ -26,7 +26,7 @@ PowerTerm powerTerm(double u, double g) {
 }  // namespace
 
 void parameterGradient(const geometry::ShapeParameters& p, const Eigen::MatrixX3d& at, Eigen::MatrixXd& J,
-                       Eigen::VectorXd& gradient_norms) {
+                       Eigen::VectorXd& gradient_norms, int threads) {
   const ShapeModel model = p.model;
   const bool sphere = model == ShapeModel::Sphere;
   const bool ovoidal = model == ShapeModel::Ovoid || model == ShapeModel::Superovoid;
@@ -48,7 +48,7 @@ void parameterGradient(const geometry::ShapeParameters& p, const Eigen::MatrixX3
   gradient_norms.resize(at.rows());
   const Vector3d inv_r = radii.cwiseInverse();
   // Rows are independent: split over threads (10^6 points in a fit).
-  parallelFor(at.rows(), 4096, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+  parallelFor(at.rows(), 4096, threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       const Vector3d v = at.row(i).transpose() - p.center;
       const Vector3d u = (R.transpose() * v).cwiseProduct(inv_r);

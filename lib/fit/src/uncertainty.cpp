@@ -121,7 +121,7 @@ UncertaintyMethod uncertaintyMethodFromName(const std::string& name) {
 
 ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points,
                                           const Eigen::MatrixX3d& closest, UncertaintyMethod method,
-                                          const EdgeOffsetField& edge_offset) {
+                                          const EdgeOffsetField& edge_offset, int threads) {
   const auto names = geometry::parameterNames(fitted.model);
   const auto kinds = geometry::parameterKinds(fitted.model);
   const Eigen::Index n = points.rows(), m = static_cast<Eigen::Index>(names.size());
@@ -130,7 +130,7 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
                      std::to_string(n));
   Eigen::VectorXd residual;
   Eigen::MatrixX3d feet = closest;
-  distance::SignedDistance(fitted).evaluate(points, residual, feet, distance::SignedDistance::Start::WarmExact);
+  distance::SignedDistance(fitted, threads).evaluate(points, residual, feet, distance::SignedDistance::Start::WarmExact);
   // An ovoid in its gauge c0x = c0y = 1 (the same surface): a and b are then its semi-axes.
   geometry::ShapeParameters shape = fitted;
   Eigen::VectorXd to_raw = Eigen::VectorXd::Ones(m);  // raw standard error = canonical one x this
@@ -151,7 +151,7 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
   }
   Eigen::MatrixXd full;
   Eigen::VectorXd gradient_norms;
-  parameterGradient(shape, feet, full, gradient_norms);
+  parameterGradient(shape, feet, full, gradient_norms, threads);
   // The derivatives of the signed distances (envelope theorem, parameter_gradient.hpp).
   for (Eigen::Index i = 0; i < n; ++i) full.row(i) /= std::max(gradient_norms[i], 1e-300);
   // The edge offset's fields n_x, n_y, n_z, (n . s)^2, (n . s)^3, each less its mean

@@ -503,7 +503,7 @@ std::vector<CortexTissue> nearbyTissue(const std::vector<Eigen::Vector3d>& point
   return out;
 }
 
-PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int threads) {
   PointSpread ps;
   ps.profiles = static_cast<int>(all_lines.size());
   if (all_lines.size() < static_cast<size_t>(kMinLines)) return ps;
@@ -536,7 +536,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines) {
     trial.sigma_mm = in_plane;
     trial.slice_sigma_mm = across;
     std::vector<double> each(subset.size());
-    parallelFor(static_cast<std::ptrdiff_t>(subset.size()), 8, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    parallelFor(static_cast<std::ptrdiff_t>(subset.size()), 8, threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
         each[i] = profileLogLikelihood(subset[i], trial, held ? &(*held)[i] : nullptr);
     });

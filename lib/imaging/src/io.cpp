@@ -525,16 +525,13 @@ void limitImagingThreads(int threads) {
   itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(n);
 }
 
-struct VolumeMemory::Kept {
-  std::string key;  // the input, its options and its files' fingerprint
-  std::shared_ptr<const Volume> volume;
-  ReadReport report;
-  long long hits = 0;
-};
-
 namespace {
 
-VolumeMemory::Kept* g_volume_memory = nullptr;
+// A read and its report, kept together in a run's memory.
+struct KeptRead {
+  Volume volume;
+  ReadReport report;
+};
 
 /// What identifies a read: the input's path and options, and every file's
 /// name, size and modification time (a folder's recursively, in name order).
@@ -563,41 +560,21 @@ Volume readVolumeFromFiles(const fs::path& input, const ReadOptions& options, Re
 
 }  // namespace
 
-VolumeMemory::VolumeMemory() : kept_(new Kept) {
-  if (g_volume_memory) {
-    delete kept_;
-    throw ProcessingError("one volume memory at a time");
-  }
-  g_volume_memory = kept_;
-}
-
-VolumeMemory::~VolumeMemory() {
-  g_volume_memory = nullptr;
-  delete kept_;
-}
-
-long long VolumeMemory::hits() const { return kept_->hits; }
-
 std::shared_ptr<const Volume> readSharedVolume(const fs::path& input, const ReadOptions& options,
-                                               ReadReport* report_out) {
-  if (!g_volume_memory) {
+                                               ReadReport* report_out, RunMemory* memory) {
+  if (!memory) {
     ReadReport report;
     auto volume = std::make_shared<const Volume>(readVolumeFromFiles(input, options, report));
     if (report_out) *report_out = report;
     return volume;
   }
-  VolumeMemory::Kept& kept = *g_volume_memory;
-  const std::string key = readKey(input, options);
-  if (key == kept.key) {
-    ++kept.hits;
-  } else {
-    kept.key.clear();  // a failed read keeps nothing
-    kept.volume.reset();
-    kept.volume = std::make_shared<const Volume>(readVolumeFromFiles(input, options, kept.report));
-    kept.key = key;
-  }
-  if (report_out) *report_out = kept.report;
-  return kept.volume;
+  const std::shared_ptr<const KeptRead> kept = memory->kept<KeptRead>("ct", readKey(input, options), [&] {
+    KeptRead read;
+    read.volume = readVolumeFromFiles(input, options, read.report);
+    return read;
+  });
+  if (report_out) *report_out = kept->report;
+  return {kept, &kept->volume};  // shares the kept read's ownership
 }
 
 Volume readVolume(const fs::path& input, const ReadOptions& options, ReadReport* report_out) {

@@ -475,7 +475,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     std::vector<imaging::LineVoxels> lines;
     const size_t stride = std::max<size_t>(1, on_edge.size() / kPointSpreadLines);
     for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i], false));
-    spread = imaging::estimatePointSpread(lines);
+    spread = imaging::estimatePointSpread(lines, options.threads);
     if (!spread.found) {
       s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(spread.profiles) +
                             " edges; the edges are the steepest falls";
@@ -503,7 +503,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   // of their neighbourhood (imaging::fitCortex).
   std::vector<imaging::CortexFit> fits(on_edge.size());
   const auto fitLines = [&](bool which, const std::vector<imaging::CortexTissue>* held) {
-    parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    parallelFor(static_cast<std::ptrdiff_t>(on_edge.size()), 64, options.threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
       for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
         const auto v = static_cast<size_t>(on_edge[i]);
         if (static_cast<bool>(within[v]) != which) continue;

@@ -81,7 +81,7 @@ void refuseOutputsNotOurs(const SubjectRun& run, Range range) {
 // Runs the stages of `range` under the output folder's lock.
 RunRecord runStages(const SubjectRun& run, Range range) {
   refuseOutputsNotOurs(run, range);
-  const imaging::VolumeMemory read_once;
+  RunMemory memory;  // the CT, read once for the stages that take it
   // The folders a run writes in: the subject's, its errors and its stamps.
   int stale = 0;
   for (const fs::path& folder : {run.output, run.output / "errors", run.output / ".articula"})
@@ -113,7 +113,7 @@ RunRecord runStages(const SubjectRun& run, Range range) {
     log::info("run: [" + std::to_string(i - range.first + 1) + "/" + std::to_string(range.last - range.first + 1) + "] " +
               stage.name + " ...");
     const auto t0 = std::chrono::steady_clock::now();
-    const int rc = cli::runCommandInProcess(stage.name, plan.arguments);
+    const int rc = cli::runCommandInProcess(stage.name, plan.arguments, &memory);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (rc != 0) {
       // Nothing of it written: its stamp would keep an empty folder.

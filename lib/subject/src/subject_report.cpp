@@ -152,7 +152,7 @@ std::shared_ptr<const imaging::Volume> readSubjectCt(const SubjectReportOptions&
   try {
     imaging::ReadOptions read;
     read.series_uid = o.series_uid;
-    return imaging::readSharedVolume(o.ct, read);
+    return imaging::readSharedVolume(o.ct, read, nullptr, o.memory);
   } catch (const Error& e) {
     why_not = std::string("No CT slices: ") + e.what();
     log::warn(std::string("report: the head checks against the CT are left out: ") + e.what());

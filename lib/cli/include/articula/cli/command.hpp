@@ -11,6 +11,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "articula/core/run_memory.hpp"
+
 namespace articula::cli {
 
 /// Options every command has (../shared/GUIDE.md conventions).
@@ -21,6 +23,9 @@ struct CommonOptions {
   bool json = false;          // --json: machine-readable summary on stdout
   bool force = false;         // --force: overwrite existing outputs
   std::string config_file;    // --config: CLI11 TOML/INI file with option values
+  /// The memory of the run that runs this command in its process (the CT
+  /// read once for every stage); null when the command runs on its own.
+  RunMemory* memory = nullptr;
 
   /// Resolved thread count (>= 1).
   int threadCount() const;
@@ -73,7 +78,8 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
 /// the program name), exactly as `articula <name> args...` would, returning
 /// its exit code; errors are reported on stderr as usual. Provenance written
 /// by the command records `articula <name> args...` as its command line.
-int runCommandInProcess(const std::string& name, const std::vector<std::string>& args);
+/// `memory`: the caller's run memory, which the command may read from and add to.
+int runCommandInProcess(const std::string& name, const std::vector<std::string>& args, RunMemory* memory = nullptr);
 
 /// Parses `args` as `articula <name> args...` would, without running the
 /// command: the parser's complaint (an unknown option, a value of the wrong

@@ -28,10 +28,11 @@ struct Provenance {
   nlohmann::json parameters = nlohmann::json::object();
   std::vector<std::filesystem::path> inputs;  // hashed into "inputs"
   long long seed = -1;                        // -1: no randomness involved
+  int threads = 1;                            // worker threads the command used
 };
 
 /// {"articula_version", "git_commit", "command", ["invoked_by",] "seed", "parameters",
-///  "inputs": [{"path","sha256"}], "coordinate_system": "LPS", "units": "mm"}
+///  "inputs": [{"path","sha256"}], "threads", "coordinate_system": "LPS", "units": "mm"}
 nlohmann::json provenanceJson(const Provenance& p);
 
 }  // namespace articula

@@ -27,8 +27,9 @@ struct ClosestPoint {
 
 class SignedDistance {
  public:
-  /// Validates `shape` (InvalidParameter otherwise).
-  explicit SignedDistance(const geometry::ShapeParameters& shape);
+  /// Validates `shape` (InvalidParameter otherwise). evaluate() splits its
+  /// points over `threads` threads (0: every hardware thread).
+  explicit SignedDistance(const geometry::ShapeParameters& shape, int threads = 1);
   ~SignedDistance();
   SignedDistance(SignedDistance&&) noexcept;
   SignedDistance& operator=(SignedDistance&&) noexcept;
@@ -73,6 +74,7 @@ class SignedDistance {
   Eigen::Vector3d radialProjection(const Eigen::Vector3d& x) const;
 
   geometry::ShapeParameters shape_;
+  int threads_ = 1;
   std::unique_ptr<geometry::PosedSurface> surface_;
   geometry::Pose pose_;
   Eigen::Matrix3d rotation_;
@@ -88,6 +90,6 @@ class SignedDistance {
 };
 
 /// Signed distances of `points` (#P x 3) to `shape`: convenience over SignedDistance.
-Eigen::VectorXd signedDistances(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
+Eigen::VectorXd signedDistances(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points, int threads = 1);
 
 }  // namespace articula::distance

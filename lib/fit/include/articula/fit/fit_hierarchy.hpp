@@ -50,6 +50,7 @@ struct Options {
   Strategy strategy = Strategy::Local;
   std::string local_algorithm = "LM";  // Levenberg-Marquardt (ours); or NLopt LD_SLSQP, LN_BOBYQA, LD_LBFGS, ...
   unsigned seed = 42;                  // NLopt's random seed (CRS2)
+  int threads = 1;                     // worker threads (0: every hardware thread); the same fits for any count
   int max_evaluations = 4000;          // per local run
   int global_evaluations = 3000;       // per global run (GlobalLocal)
   int restarts = 2;                    // local restarts from the result while they gain > 1e-6 relative
@@ -113,7 +114,7 @@ ModelFit fitFrom(const geometry::ShapeParameters& start, const Eigen::MatrixX3d&
 
 /// The thesis objective eq. 3.1 and the geometric SSE (mm^2) of a shape.
 double algebraicObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
-double geometricObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);
+double geometricObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points, int threads = 1);
 
 /// The NLopt and Eigen versions this build fits with.
 std::string nloptVersion();

@@ -11,8 +11,9 @@ namespace articula::fit {
 /// angle derivatives by central differences of the 3 x 3 matrix, once), and
 /// the norms of the spatial gradients |grad_x F| (#P) in `gradient_norms`.
 /// With closest points as `at`, row i / |grad_x F| is the derivative of the
-/// signed distance of point i (the envelope theorem).
+/// signed distance of point i (the envelope theorem). Rows are split over
+/// `threads` threads (0: every hardware thread).
 void parameterGradient(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& at, Eigen::MatrixXd& jacobian,
-                       Eigen::VectorXd& gradient_norms);
+                       Eigen::VectorXd& gradient_norms, int threads = 1);
 
 }  // namespace articula::fit

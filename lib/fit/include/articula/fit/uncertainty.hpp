@@ -100,6 +100,6 @@ struct ParameterUncertainty {
 ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitted, const Eigen::MatrixX3d& points,
                                           const Eigen::MatrixX3d& closest = {},
                                           UncertaintyMethod method = UncertaintyMethod::SpatialModel,
-                                          const EdgeOffsetField& edge_offset = {});
+                                          const EdgeOffsetField& edge_offset = {}, int threads = 1);
 
 }  // namespace articula::fit

@@ -170,7 +170,7 @@ struct PointSpread {
 /// or more), each fitted with the tissue of its nearest lines within the
 /// slices (nearbyTissue): across long or thick slices a thin cortex's
 /// thickness trades against the blur, and the width with it (held_across).
-PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines);
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, int threads = 1);
 
 /// Lines whose slice share is below this lie within the slices: across
 /// them a line sees the in-plane voxel's extent and blur only.

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "articula/core/run_memory.hpp"
 #include "articula/imaging/image.hpp"
 
 namespace articula::imaging {
@@ -51,33 +52,16 @@ std::vector<SeriesInfo> listDicomSeries(const std::filesystem::path& folder);
 /// non-orthonormal direction matrix.
 Volume readVolume(const std::filesystem::path& input, const ReadOptions& options, ReadReport* report = nullptr);
 
-/// The same without a copy: while a VolumeMemory is alive, the kept volume
-/// itself (a CT is hundreds of megabytes).
+/// The same without a copy. With a run's memory (RunMemory), the volume read
+/// for this input and these options is kept, and read again only when its
+/// files have changed (names, sizes, modification times): `articula run`
+/// reads the CT once for all its stages instead of once per stage.
 std::shared_ptr<const Volume> readSharedVolume(const std::filesystem::path& input, const ReadOptions& options,
-                                               ReadReport* report = nullptr);
+                                               ReadReport* report = nullptr, RunMemory* memory = nullptr);
 
 /// ITK's filters use at most `threads` threads (ITK's own pool otherwise
 /// takes every core, whatever --threads says).
 void limitImagingThreads(int threads);
-
-/// While one is alive, readVolume keeps the last volume it read and answers
-/// the same input read again with the same options from memory, provided its
-/// files are unchanged (names, sizes and modification times): `articula run`
-/// reads the CT once for all its stages instead of once per stage. One at a
-/// time per process; the stages of a run follow one another, so no locking.
-class VolumeMemory {
- public:
-  VolumeMemory();
-  ~VolumeMemory();
-  VolumeMemory(const VolumeMemory&) = delete;
-  VolumeMemory& operator=(const VolumeMemory&) = delete;
-  long long hits() const;  // reads answered from memory
-
-  struct Kept;  // the kept volume (io.cpp)
-
- private:
-  Kept* kept_;
-};
 
 /// The voxel grid of an image file (.nii.gz/.nii/.nrrd/.mha) from its header
 /// alone (no voxels read). Throws InputError for another file, a header ITK

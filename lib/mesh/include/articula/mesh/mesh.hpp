@@ -72,6 +72,7 @@ struct EdgeSnapOptions {
   /// slices and across them (0: both estimated from the CT's own edges;
   /// the slice width 0: as within the slices).
   double point_spread_mm = 0, slice_point_spread_mm = 0;
+  int threads = 1;  // worker threads of the cortex model's fits (0: every hardware thread)
   /// Throws UsageError naming the first invalid option.
   void validate() const;
 };

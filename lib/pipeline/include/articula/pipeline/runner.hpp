@@ -6,7 +6,8 @@
 // write. A stage whose outputs exist and whose inputs (SHA-256), arguments
 // and articula build are unchanged is skipped (stamps in
 // <output>/.articula/<stage>.json). The CT is read once: the stages that
-// take it get it from memory (imaging::VolumeMemory). `articula run` is its
+// take it get it from the run's memory (core/run_memory.hpp, handed to each
+// stage's command as cli::CommonOptions::memory). `articula run` is its
 // command line; the stage commands must be linked in (apps/, as the
 // `articula` executable links them).
 #include <filesystem>

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "articula/checks/qc.hpp"
+#include "articula/core/run_memory.hpp"
 #include "articula/statistics/model_selection.hpp"
 
 namespace articula::subject {
@@ -21,6 +22,7 @@ struct SubjectReportOptions {
   double selection_alpha = statistics::kDefaultSelectionAlpha;
   double selection_length_mm = statistics::kDefaultSelectionLengthMm;  // 0: each fit's own residual correlation
   long long seed = -1;           // recorded in the provenance
+  RunMemory* memory = nullptr;   // a run's memory: the CT its earlier stages read (cli::CommonOptions::memory)
 };
 
 /// Writes results.json, results.csv, head.mrk.json and report.html into options.folder and
