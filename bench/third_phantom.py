@@ -12,7 +12,9 @@ physical LPS points; imaging: point sampling or sub^3 supersampling, Gaussian /
 box / Lorentzian blur (separate in-plane and slice widths), white or
 correlated noise, cupping, trabecular texture, int16 with scl_slope/inter or
 float32, LPS/RAS/oblique storage, sform and/or qform, cropped fields of view,
-with or without air around the body.
+with or without air around the body. Clinical additions on a hip: a dome cut
+flat (an arthritic head's weight-bearing zone) and a lag screw along the neck
+with streaks, made here independently of `articula phantom`'s.
 
     python3 bench/third_phantom.py out=DIR/name [key=value ...]      (see DEFAULTS below)
 
@@ -37,6 +39,8 @@ DEFAULTS = dict(
     orient="lps", obl="0,0,0", hdr="sform", gz="1",      # lps: direction I; ras: diag(-1,-1,1); obl: rotation (deg xyz) applied to the lps/ras base
     fov="70,70,70", fov_shift="0,0,0", air="1",
     glen_si="32", glen_ap="22",
+    dome_cut="0",                                         # hip: the primary head's dome cut flat this far below its top (a fraction of R; new cortex over the cut)
+    metal="none",                                         # hip: screw (a lag screw along the primary neck into the head, with radial streaks in its slices)
     gap_hu="",                                            # fill the joint space (within the socket's cover) with this HU (arthrography contrast, 0-600)                           # shoulder: glenoid half-angles (deg), superior-inferior / anterior-posterior
 )
 
@@ -92,6 +96,7 @@ class Scene:
         self.rng = rng
         self.bones = []   # (name, level_fn, cortex_fn, cort_hu, trab_hu, role)
         self.heads = []
+        self.metal = []   # (end, end, radius): screws
         j = a["joint"]
         if j == "hip":
             sides = ["right", "left"] if a["both"] == "1" else [a["side"]]
@@ -131,9 +136,15 @@ class Scene:
         Rmax = rad.max()
         e0 = c + (Rmax + 24) * n0  # neck end (canonical)
         # canonical femur pieces (frame rotated by Rf about c)
+        # A flattened dome: the head cut by a plane dome_cut x R below its top
+        # along +z (superior), the level's shell giving it new cortex.
+        cut = self.fl("dome_cut") * R if primary else 0.0
+        top = np.sqrt(((rad * (A.T @ np.array([0, 0, 1.0]))) ** 2).sum())  # the ellipsoid's support height along +z
         def femur_level(P, parts=False):
             Q = c + (P - c) @ Rf
             head = ell_level(P, c, rad, A)
+            if cut > 0:
+                head = np.maximum(head, (P[:, 2] - c[2]) - (top - cut))
             neck = capsule(Q, c + 0.35 * R * n0, e0, 0.58 * R)
             shaft = capsule(Q, e0 + np.array([0, 0, 6.0]), e0 + np.array([s * 4, 4, -160.0]), 0.6 * R)
             gt = ell_level(Q, e0 + np.array([s * 9, 7, 14]), np.array([12.0, 15, 19]), np.eye(3))
@@ -167,8 +178,14 @@ class Scene:
         self._cortex_of["femur_" + sd] = t
         self.fills = getattr(self, "fills", [])
         self.fills.append(lambda P: (ball(P, cs, Rs) < 0) & (cone_level(P, cs, u, theta_fn) < 0) & (femur_level(P) > 0))
+        if primary and self.a["metal"] == "screw":
+            # A 6.5 mm lag screw from the lateral cortex along the neck, its tip half a radius past the centre.
+            self.metal.append((c + (Rmax + 60) * (Rf @ n0), c - 0.5 * R * (Rf @ n0), 3.25))
+        elif self.a["metal"] not in ("none", "screw"):
+            raise SystemExit("metal: none|screw")
         self.heads.append(dict(side=sd, center=c, radii=rad, axes=A, gap=gap, socket_center=cs, socket_radius=Rs,
-                               socket_dome=u, cover_deg=self.fl("cover"), neck_dir=Rf @ n0, primary=primary))
+                               socket_dome=u, cover_deg=self.fl("cover"), neck_dir=Rf @ n0, primary=primary,
+                               dome_cut_mm=cut, dome_top_mm=float(c[2] + top)))
 
     def add_sacrum(self):
         def sac(P):
@@ -297,7 +314,38 @@ class Scene:
             trab = L <= -t
             hu[trab] = thu + tex(P[trab])
             mat[trab] = 11 + 2 * bi
+        for p0, p1, r in self.metal:
+            m = capsule(P, p0, p1, r) <= 0
+            hu[m] = METAL_HU
+            mat[m] = METAL_MATERIAL
         return hu, rho0, mat
+
+
+METAL_HU, METAL_MATERIAL = 3000.0, 9
+
+
+def add_metal_streaks(vol, mat, sp, D, rng):
+    """Streaks in each slice (index axis 2) that holds metal: a dark band
+    along the metal's longest in-plane extent (photon starvation, beam
+    hardening) and bright and dark rays alternating about it, fading over
+    about 50 mm."""
+    for k in range(vol.shape[2]):
+        ii, jj = np.nonzero(mat[:, :, k] == METAL_MATERIAL)
+        if len(ii) == 0:
+            continue
+        xy = np.stack([ii * sp[0], jj * sp[1]], 1)
+        mid = xy.mean(0)
+        spread = np.cov((xy - mid).T) if len(ii) > 2 else np.eye(2)
+        w, v = np.linalg.eigh(spread + 1e-9 * np.eye(2))
+        along = np.arctan2(v[1, 1], v[0, 1])  # the longest in-plane extent
+        X, Y = np.meshgrid(np.arange(vol.shape[0]) * sp[0] - mid[0], np.arange(vol.shape[1]) * sp[1] - mid[1], indexing="ij")
+        d = np.hypot(X, Y)
+        th = np.arctan2(Y, X) - along
+        off = np.angle(np.exp(2j * th)) / 2  # angle from the band's line, in (-pi/2, pi/2]
+        amp = 450.0 * min(1.0, len(ii) / 20.0)
+        streak = amp * np.exp(-d / 50.0) * (0.5 * np.cos(10 * th + rng.uniform(0, 2 * np.pi)) - np.exp(-0.5 * (off / 0.12) ** 2))
+        streak[d < 4.0] = 0
+        vol[:, :, k] += streak.astype(np.float32)
 
 
 def kernel1d(kind, w_mm, sp):
@@ -385,6 +433,8 @@ def main():
         kern = kernel1d(a["blur"], widths[ax_], sp[ax_])
         if kern is not None:
             vol = ndimage.convolve1d(vol, kern.astype(np.float32), axis=ax_, mode="nearest")
+    if sc.metal:
+        add_metal_streaks(vol, mat, sp, D, rng)
     # cupping: darker in the body's middle
     cup = float(a["cupping"])
     if cup:
@@ -448,7 +498,8 @@ def main():
                           axes_lps_columns=h["axes"].tolist(), gap_mm=h["gap"], socket_center_mm=h["socket_center"].tolist(),
                           socket_radius_mm=h["socket_radius"], socket_dome_dir=h["socket_dome"].tolist(),
                           cover_deg=h["cover_deg"], primary=h["primary"],
-                          clearance_mm=h["clearance"], head_surface_free_share=h["free_share"]))
+                          clearance_mm=h["clearance"], head_surface_free_share=h["free_share"],
+                          dome_cut_mm=h.get("dome_cut_mm", 0.0), metal=a["metal"] if h["primary"] else "none"))
     truth = dict(generator="third_phantom", coordinate_system="LPS", units="mm", options=a, spacing_mm=sp.tolist(), size=n.tolist(),
                  direction_lps=D.tolist(), origin_lps=O.tolist(), heads=heads,
                  head_center_mm=prim["center"].tolist(), radii_mm=prim["radii"].tolist(), axes_lps_columns=prim["axes"].tolist(),

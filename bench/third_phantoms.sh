@@ -5,7 +5,8 @@
 # glenoids; point-sampled and partial-volume voxels, Gaussian, box and
 # Lorentzian blur, correlated noise, cupping, int16 with slope/intercept,
 # oblique and RAS storage, cropped fields of view with and without air;
-# clinical voxels up to 2 x 2 x 3 mm.
+# clinical voxels up to 2 x 2 x 3 mm; a lag screw, flattened domes, low-dose
+# noise and heads clipped by the field of view (the K cases).
 # Each head is correct (articular points' RMS to the true head <= half the
 # in-plane voxel and >= 95 % within 1.5 mm), refused (exit != 0), wrong but
 # warned (exit 0, a check of the head or its surface warned: not only the
@@ -109,6 +110,18 @@ cases=(
 "C17|right|joint=hip side=right seed=617 R=23 gap=2.5 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 noise=20 spacing=1.0,1.0,2.0 blur_xy=0.5 blur_z=1.0"
 "C18|left|joint=hip side=left seed=618 R=24 gap=2.5 cortex=0.8 cort_hu=700 trab_hu=150 spacing=2.0,2.0,3.0 blur_xy=1.0 blur_z=1.5 fov=80,80,80"
 "C19|right|joint=shoulder side=right seed=619 R=25 gap=3 excess=8 cortex=0.7 cort_hu=600 trab_hu=100 tex=40 noise=15 fov=80,80,80 spacing=1.5,1.5,3.0 blur_xy=0.8 blur_z=1.5"
+# Clinical failure modes made by this generator: a lag screw with its
+# streaks, a flattened dome, low-dose noise, heads clipped by the field of
+# view (the top of the field 0.75 or 0.9 radii above the centre; fov gives
+# half-widths).
+"K1|right|joint=hip side=right seed=701 R=24 gap=2.5 metal=screw spacing=0.8,0.8,1.5"
+"K2|left|joint=hip side=left seed=702 R=22 gap=2.5 dome_cut=0.12 spacing=0.7,0.7,1.0"
+"K3|right|joint=hip side=right seed=703 R=25 gap=3 dome_cut=0.25 spacing=1.0,1.0,2.0"
+"K4|left|joint=hip side=left seed=704 R=23 gap=2.5 noise=80 spacing=0.8,0.8,1.25"
+"K5|right|joint=hip side=right seed=705 R=23 gap=2.5 fov=70,70,70 fov_shift=0,0,-52.75 spacing=0.7,0.7,1.0"
+"K6|left right|joint=hip both=1 side=left seed=706 R=24 gap=2.5 metal=screw fov=175,75,70 spacing=1.0,1.0,2.0"
+"K7|right|joint=shoulder side=right seed=707 R=22 gap=3 excess=8 fov=75,75,75 fov_shift=0,0,-55.2 spacing=0.8,0.8,2.0"
+"K8|right|joint=hip side=right seed=708 R=20 gap=2 dome_cut=0.12 spacing=0.9,0.9,2.5"
 )
 echo "| case | side | joint | voxels (mm) | cortex (mm) | gap (mm) | exit | qc | verdict | centre error (mm) | mean signed (mm) | RMS (mm) | within 1.5 mm | message |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"

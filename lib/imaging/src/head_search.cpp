@@ -241,10 +241,11 @@ class LatticeLookup {
 }  // namespace
 
 /// The head's edge distance per lattice direction, with the holes of its cap
-/// (a missed edge, the fovea's pit) filled from their neighbours: a
-/// direction without an edge whose nearest neighbours mostly have one lies
-/// inside the cap. The neck's directions, without neighbours on the cap, stay
-/// empty. `slice_axis`: the grid's slice normal (unit, LPS).
+/// (a missed edge, the fovea's pit, a flattened dome) filled from their
+/// neighbours: a direction without an edge whose nearest neighbours mostly
+/// have one lies inside the cap, and so does every part without edges but
+/// the largest. The neck's directions, that largest part, stay empty.
+/// `slice_axis`: the grid's slice normal (unit, LPS).
 std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis) {
   std::vector<double> edge = head.edge_mm;
   constexpr int kNeighbours = 6;
@@ -280,6 +281,43 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
   };
   for (int ring = 0; ring < 2; ++ring) fillRing([](int) { return true; });
   for (int ring = 0; ring < 3; ++ring) fillRing([&at_pole](int n) { return at_pole[static_cast<size_t>(n)] != 0; });
+  // Wider holes the cap's edges enclose (a dome flattened or eroded below
+  // the sphere's band, its rays' edges all outliers) take their rim's mean,
+  // ring by ring: left open, they kept the socket across a gap the closing
+  // bridged. The largest part without edges is the neck's side, left open.
+  std::vector<int> part(kRayCount, -1), part_size;
+  for (int n = 0; n < kRayCount; ++n) {
+    if (!std::isnan(edge[static_cast<size_t>(n)]) || part[static_cast<size_t>(n)] >= 0) continue;
+    const int id = static_cast<int>(part_size.size());
+    part_size.push_back(0);
+    std::vector<int> todo{n};
+    part[static_cast<size_t>(n)] = id;
+    while (!todo.empty()) {
+      const int m = todo.back();
+      todo.pop_back();
+      ++part_size.back();
+      for (int k : neighbours[static_cast<size_t>(m)])
+        if (std::isnan(edge[static_cast<size_t>(k)]) && part[static_cast<size_t>(k)] < 0) part[static_cast<size_t>(k)] = id, todo.push_back(k);
+    }
+  }
+  if (part_size.size() > 1) {
+    const int neck = static_cast<int>(std::max_element(part_size.begin(), part_size.end()) - part_size.begin());
+    for (int ring = 0; ring < kRayCount; ++ring) {
+      std::vector<double> next = edge;
+      bool open = false;
+      for (int n = 0; n < kRayCount; ++n) {
+        if (!std::isnan(edge[static_cast<size_t>(n)]) || part[static_cast<size_t>(n)] == neck) continue;
+        double sum = 0;
+        int count = 0;
+        for (int m : neighbours[static_cast<size_t>(n)])
+          if (!std::isnan(edge[static_cast<size_t>(m)])) sum += edge[static_cast<size_t>(m)], ++count;
+        if (count > 0) next[static_cast<size_t>(n)] = sum / count;
+        else open = true;
+      }
+      edge = next;
+      if (!open) break;
+    }
+  }
   return edge;
 }
 
