@@ -252,6 +252,13 @@ HeadCheck checkHead(const phantom::Phantom& p, const imaging::Label& label, cons
           (s.head_center_mm - p.head.center).norm()};
 }
 
+// Segments the phantom's CT as `articula segment` would (its summary into
+// `s`) and checks the label against the phantom's truth.
+HeadCheck segmentAndCheck(const phantom::Phantom& p, const imaging::SegmentOptions& so, imaging::SegmentSummary& s) {
+  const imaging::Label label = imaging::segmentHead(p.ct, so, &s);
+  return checkHead(p, label, s);
+}
+
 TEST(ImagingSegment, PhantomHeadMatchesTruthAcrossGapsSidesAndSpacings) {
   struct Case { double gap; bool right; Eigen::Vector3d spacing; };
   for (const Case& c : {Case{2.0, true, {0.7, 0.7, 1.5}}, Case{4.0, false, {0.7, 0.7, 1.5}},
@@ -266,8 +273,7 @@ TEST(ImagingSegment, PhantomHeadMatchesTruthAcrossGapsSidesAndSpacings) {
     imaging::SegmentOptions so;
     so.side = c.right ? imaging::Side::Right : imaging::Side::Left;
     imaging::SegmentSummary s;
-    const imaging::Label label = imaging::segmentHead(p.ct, so, &s);
-    const HeadCheck h = checkHead(p, label, s);
+    const HeadCheck h = segmentAndCheck(p, so, s);
     SCOPED_TRACE("gap " + std::to_string(c.gap) + (c.right ? " right" : " left"));
     EXPECT_GT(h.head_recall, 0.97);
     EXPECT_LT(h.socket_leak, 0.01);
@@ -357,8 +363,7 @@ TEST(ImagingSegment, ACandidateMeasuredFromNearItsEdgeKeepsTheHeadsRim) {
   imaging::writeVolume(dir / "ct.nii.gz", p.ct);
   p.ct = imaging::readVolume(dir / "ct.nii.gz", {});
   imaging::SegmentSummary s;
-  const imaging::Label label = imaging::segmentHead(p.ct, {}, &s);
-  const HeadCheck h = checkHead(p, label, s);
+  const HeadCheck h = segmentAndCheck(p, {}, s);
   EXPECT_GT(h.head_recall, 0.97);
   EXPECT_LT(h.socket_leak, 0.01);
   EXPECT_LT(h.center_error_mm, 1.0);
@@ -396,8 +401,7 @@ TEST(ImagingSegment, ALagScrewsStreaksInsideTheHeadDoNotHideIt) {
   imaging::writeVolume(dir / "ct.nii.gz", p.ct);  // int16, as `articula phantom` stores it
   p.ct = imaging::readVolume(dir / "ct.nii.gz", {});
   imaging::SegmentSummary s;
-  const imaging::Label label = imaging::segmentHead(p.ct, {}, &s);
-  const HeadCheck h = checkHead(p, label, s);
+  const HeadCheck h = segmentAndCheck(p, {}, s);
   EXPECT_EQ(s.head_found_by, "edges");
   EXPECT_LT(h.center_error_mm, 1.5);
   EXPECT_NEAR(s.search_radius_mm, p.head.radii.mean(), 1.5);
@@ -418,8 +422,7 @@ TEST(ImagingSegment, LowDoseNoiseClosedAroundTheHeadIsCutOff) {
   imaging::SegmentOptions so;
   so.side = imaging::Side::Left;
   imaging::SegmentSummary s;
-  const imaging::Label label = imaging::segmentHead(p.ct, so, &s);
-  const HeadCheck h = checkHead(p, label, s);
+  const HeadCheck h = segmentAndCheck(p, so, s);
   EXPECT_EQ(s.head_found_by, "edges");
   EXPECT_GT(h.head_recall, 0.95);
   EXPECT_LT(h.socket_leak, 0.02);
@@ -438,8 +441,7 @@ TEST(ImagingSegment, AFlattenedDomesGapToTheSocketIsCutOff) {
   o.flattened_dome = 0.25;
   const phantom::Phantom p = phantom::makePhantom(o);
   imaging::SegmentSummary s;
-  const imaging::Label label = imaging::segmentHead(p.ct, {}, &s);
-  const HeadCheck h = checkHead(p, label, s);
+  const HeadCheck h = segmentAndCheck(p, {}, s);
   EXPECT_EQ(s.head_found_by, "edges");
   EXPECT_GT(h.head_recall, 0.95);
   EXPECT_LT(h.socket_leak, 0.005);  // 0.027 before

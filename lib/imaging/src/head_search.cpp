@@ -266,21 +266,26 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
     for (int k = 0; k < kNeighbours; ++k) neighbours[static_cast<size_t>(n)].push_back(by_angle[static_cast<size_t>(k)].second);
   }
   // One ring of the holes filled: a direction without an edge, among those
-  // `where` admits, takes the mean edge of its neighbours if most have one.
-  const auto fillRing = [&](const auto& where) {
+  // `where` admits, takes the mean edge of its neighbours if at least
+  // `least` of them have one. Whether an admitted direction stays empty.
+  const auto fillRing = [&](const auto& where, int least) {
     std::vector<double> next = edge;
+    bool open = false;
     for (int n = 0; n < kRayCount; ++n) {
       if (!std::isnan(edge[static_cast<size_t>(n)]) || !where(n)) continue;
       double sum = 0;
       int count = 0;
       for (int m : neighbours[static_cast<size_t>(n)])
         if (!std::isnan(edge[static_cast<size_t>(m)])) sum += edge[static_cast<size_t>(m)], ++count;
-      if (count >= 4) next[static_cast<size_t>(n)] = sum / count;
+      if (count >= least) next[static_cast<size_t>(n)] = sum / count;
+      else open = true;
     }
     edge = next;
+    return open;
   };
-  for (int ring = 0; ring < 2; ++ring) fillRing([](int) { return true; });
-  for (int ring = 0; ring < 3; ++ring) fillRing([&at_pole](int n) { return at_pole[static_cast<size_t>(n)] != 0; });
+  constexpr int kMost = 4;  // of the kNeighbours
+  for (int ring = 0; ring < 2; ++ring) fillRing([](int) { return true; }, kMost);
+  for (int ring = 0; ring < 3; ++ring) fillRing([&at_pole](int n) { return at_pole[static_cast<size_t>(n)] != 0; }, kMost);
   // Wider holes the cap's edges enclose (a dome flattened or eroded below
   // the sphere's band, its rays' edges all outliers) take their rim's mean,
   // ring by ring: left open, they kept the socket across a gap the closing
@@ -302,21 +307,9 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
   }
   if (part_size.size() > 1) {
     const int neck = static_cast<int>(std::max_element(part_size.begin(), part_size.end()) - part_size.begin());
-    for (int ring = 0; ring < kRayCount; ++ring) {
-      std::vector<double> next = edge;
-      bool open = false;
-      for (int n = 0; n < kRayCount; ++n) {
-        if (!std::isnan(edge[static_cast<size_t>(n)]) || part[static_cast<size_t>(n)] == neck) continue;
-        double sum = 0;
-        int count = 0;
-        for (int m : neighbours[static_cast<size_t>(n)])
-          if (!std::isnan(edge[static_cast<size_t>(m)])) sum += edge[static_cast<size_t>(m)], ++count;
-        if (count > 0) next[static_cast<size_t>(n)] = sum / count;
-        else open = true;
-      }
-      edge = next;
-      if (!open) break;
-    }
+    const auto enclosed = [&part, neck](int n) { return part[static_cast<size_t>(n)] != neck; };
+    for (int ring = 0; ring < kRayCount; ++ring)
+      if (!fillRing(enclosed, 1)) break;
   }
   return edge;
 }
