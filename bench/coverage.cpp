@@ -23,6 +23,7 @@
 #include "articula/fit/uncertainty.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/points/point_io.hpp"
+#include "articula/testsupport/interval_errors.hpp"
 
 namespace {
 
@@ -48,13 +49,6 @@ ShapeParameters truthShape(const nlohmann::json& t) {
   for (int k = 0; k < 4 && t.contains("cx"); ++k) p.cx[k] = t.at("cx")[static_cast<size_t>(k)].get<double>();
   for (int k = 0; k < 4 && t.contains("cy"); ++k) p.cy[k] = t.at("cy")[static_cast<size_t>(k)].get<double>();
   return p;
-}
-
-// The half widths through the centre along the local axes (an ovoid's a c0x, b c0y, c).
-Eigen::Vector3d semiAxes(const ShapeParameters& s) {
-  const bool ovoid = s.model == ShapeModel::Ovoid || s.model == ShapeModel::Superovoid;
-  if (s.model == ShapeModel::Sphere) return Eigen::Vector3d::Constant(s.radii[0]);
-  return {s.radii[0] * (ovoid ? s.cx[0] : 1.0), s.radii[1] * (ovoid ? s.cy[0] : 1.0), s.radii[2]};
 }
 
 }  // namespace
@@ -84,41 +78,15 @@ int main(int argc, char** argv) {
       std::vector<double> sorted(d.data(), d.data() + d.size());
       std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
       const double offset = sorted[sorted.size() / 2];
-      const Eigen::Matrix3d Rt = articula::geometry::rotationFromAngles(truth.angles);
-      const Eigen::Vector3d true_semi = semiAxes(truth);
       for (const auto& shape : shapes) {
         if (!articula::geometry::contains(shape.model, true_model)) continue;
-        const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(shape.angles);
-        const Eigen::Vector3d semi = semiAxes(shape);
-        const bool ovoid = shape.model == ShapeModel::Ovoid || shape.model == ShapeModel::Superovoid;
         for (auto method : methods) {
           articula::fit::EdgeOffsetField field;
           if (c.contains("spacing_mm"))
             field = articula::fit::edgeOffsetField(vec3(c.at("spacing_mm")), vec3(c.at("slice_axis")));
           const auto u = articula::fit::parameterUncertainty(shape, points, {}, method, field);
-          const auto names = articula::geometry::parameterNames(shape.model);
-          auto se_of = [&](const std::string& name) {
-            const auto at = std::find(names.begin(), names.end(), name);
-            return at == names.end() ? NAN : u.standard_error[at - names.begin()];
-          };
-          nlohmann::json centre = nlohmann::json::array(), radius = nlohmann::json::array(),
-                         radius_offset = nlohmann::json::array();
-          for (int i = 0; i < 3; ++i) {
-            const std::string t = "t" + std::to_string(i + 1);
-            centre.push_back((shape.center[i] - truth.center[i]) / se_of(t));
-          }
-          const char* axis_names[3] = {"a", "b", "c"};
-          for (int i = 0; i < 3; ++i) {
-            // The fitted axis along true axis i (a sphere's single radius serves all three).
-            int j = 0;
-            if (shape.model != ShapeModel::Sphere)
-              for (int k = 1; k < 3; ++k)
-                if (std::abs(Rf.col(k).dot(Rt.col(i))) > std::abs(Rf.col(j).dot(Rt.col(i)))) j = k;
-            double se = se_of(shape.model == ShapeModel::Sphere ? "a" : axis_names[j]);
-            if (ovoid && j < 2) se *= j == 0 ? shape.cx[0] : shape.cy[0];  // of the semi-axis, c0 held
-            radius.push_back((semi[j] - true_semi[i]) / se);
-            radius_offset.push_back((semi[j] - true_semi[i] - offset) / se);
-          }
+          const articula::fit::IntervalErrors z = articula::fit::intervalErrors(shape, u, truth, offset);
+          auto list = [](const Eigen::Vector3d& v) { return nlohmann::json{v[0], v[1], v[2]}; };
           const auto& r = u.correlation;
           std::cout << nlohmann::json{{"id", c.at("id")},
                                       {"true_model", articula::geometry::modelName(true_model)},
@@ -126,9 +94,9 @@ int main(int argc, char** argv) {
                                       {"method", u.method},
                                       {"offset_mm", offset},
                                       {"edge_offset_sd_mm", {field.linear_sd_mm, field.across_slices_sd_mm, field.odd_across_slices_sd_mm}},
-                                      {"centre_z", centre},
-                                      {"radius_z", radius},
-                                      {"radius_less_offset_z", radius_offset},
+                                      {"centre_z", list(z.centre_z)},
+                                      {"radius_z", list(z.semi_axis_z)},
+                                      {"radius_less_offset_z", list(z.semi_axis_less_offset_z)},
                                       {"n", r.n},
                                       {"n_eff", r.n_eff},
                                       {"lengths_mm", {r.length_mm[0], r.length_mm[1]}},

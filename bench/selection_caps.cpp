@@ -11,12 +11,17 @@
 // Prints one JSON line per cap (true model, length, noise, the truth's
 // departure from the nearest simpler model on its exact cap, each model's
 // RMS, the true model's fitted from the truth, the models the points leave
-// undetermined, the two selections); then per rule and true model the share
+// undetermined, the two selections, and the errors of each fit containing
+// the truth in its standard errors); then per rule and true model the share
 // right, richer than the truth (the test's false positives) and simpler or
 // beside it (an ovoid for a superellipsoid); and the power: the share right
-// by the truth's departure from its simpler models over the noise. Every
+// by the truth's departure from its simpler models over the noise; and the
+// coverage of the 95 % intervals (fit/uncertainty.hpp's default, the fit's
+// own variogram) of the centre and semi-axes, of the true model's own fit
+// and of every fit containing it. Every
 // cap is seeded: a line is reproduced from its seed.
 //   bench-selection-caps [--caps 200] [--jobs 2] [--seed 1] [--length 4] [--true MODEL]
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -33,6 +38,7 @@
 #include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/shape.hpp"
 #include "articula/statistics/model_selection.hpp"
+#include "articula/testsupport/interval_errors.hpp"
 #include "articula/testsupport/run_all.hpp"
 #include "articula/testsupport/synthetic_cap.hpp"
 
@@ -84,6 +90,14 @@ int main(int argc, char** argv) {
         line["rms_mm"][articula::geometry::modelName(f.parameters.model)] = std::sqrt(f.sse_mm2 / s.points);
         if (!f.uncertainty.not_identifiable.empty())
           line["not_identifiable"][articula::geometry::modelName(f.parameters.model)] = f.uncertainty.not_identifiable;
+        if (articula::geometry::contains(f.parameters.model, model)) {
+          const auto z = articula::fit::intervalErrors(f.parameters, f.uncertainty, truth);
+          line["z"][articula::geometry::modelName(f.parameters.model)] = {
+              {"centre", {z.centre_z[0], z.centre_z[1], z.centre_z[2]}},
+              {"semi_axes", {z.semi_axis_z[0], z.semi_axis_z[1], z.semi_axis_z[2]}},
+              {"length_mm", f.uncertainty.correlation.effectiveLength()},
+              {"correlated_share", f.uncertainty.correlation.correlatedShare()}};
+        }
       }
       // The truth's own RMS on these points: a fit of the true model above it has stopped short of its optimum.
       line["truth_rms_mm"] = std::sqrt(articula::fit::fitFrom(truth, noisy).sse_mm2 / s.points);
@@ -140,6 +154,30 @@ int main(int argc, char** argv) {
       std::printf(" %.0f %% of %d |", 100.0 * right / std::max(n, 1), n);
     }
     std::printf("\n");
+  }
+  // Coverage: the share of |z| <= 1.96 over the three coordinates of the
+  // centre and the three semi-axes, of the true model's own fit and of every
+  // fit containing the truth.
+  std::printf("\ncoverage of the 95 %% intervals (centre / semi-axes):\n| true | own fit | every fit containing it |\n|---|---|---|\n");
+  auto share = [](const std::vector<double>& zs) {
+    const long held = std::count_if(zs.begin(), zs.end(), [](double z) { return std::abs(z) <= 1.96; });
+    return zs.empty() ? 0.0 : 100.0 * static_cast<double>(held) / static_cast<double>(zs.size());
+  };
+  for (ShapeModel model : models) {
+    const std::string name = articula::geometry::modelName(model);
+    std::vector<double> own[2], every[2];
+    for (const auto& line : lines) {
+      if (!line.is_object() || line.value("true", "") != name || !line.contains("z")) continue;
+      for (const auto& [fitted, z] : line["z"].items())
+        for (int part = 0; part < 2; ++part)
+          for (const auto& v : z[part == 0 ? "centre" : "semi_axes"]) {
+            if (!v.is_number()) continue;  // an interval the points leave undetermined
+            every[part].push_back(v.get<double>());
+            if (fitted == name) own[part].push_back(v.get<double>());
+          }
+    }
+    std::printf("| %s | %.1f / %.1f %% | %.1f / %.1f %% |\n", name.c_str(), share(own[0]), share(own[1]), share(every[0]),
+                share(every[1]));
   }
   return 0;
 }

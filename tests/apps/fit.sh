@@ -20,7 +20,11 @@ for key in '"least_rms_model"' '"coordinate_system": "LPS"' '"center_mm"' '"radi
 done
 grep -q '"least_rms_model": "superovoid"' "$tmp/fits.json" || fail "the least RMS is the true superovoid"
 se_a=$(csv_value "$tmp/fits.csv" sphere a_se_mm)
-python3 -c "import sys; se = float(sys.argv[1]); assert 0 < se < 0.5, se" "$se_a" || fail "the sphere's radius has no plausible standard error in fits.csv: '$se_a'"
+# The sphere misses the superovoid by 0.88 mm RMS in a pattern spanning the
+# cap, which its interval takes as an error shared over the cap: wide, but
+# finite and holding the middle of the semi-axes (21-24 mm).
+a_sphere=$(csv_value "$tmp/fits.csv" sphere a_mm)
+python3 -c "import sys; a, se = map(float, sys.argv[1:]); assert 0 < se < 2 and abs(a - 22.5) < 1.96 * se, (a, se)" "$a_sphere" "$se_a" || fail "the sphere's radius has no plausible standard error in fits.csv: '$a_sphere' +- '$se_a'"
 rms_so=$(csv_value "$tmp/fits.csv" superovoid rms_mm)
 awk -v r="$rms_so" 'BEGIN{exit !(r < 1e-4)}' || fail "superovoid rms $rms_so >= 1e-4 mm on exact points"
 c_so=$(csv_value "$tmp/fits.csv" superovoid c_mm)

@@ -186,7 +186,7 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
 
   ParameterUncertainty out;
   out.method = uncertaintyMethodName(method);
-  out.correlation = estimateResidualCorrelation(points, residual, 1, method != UncertaintyMethod::SpatialModel);
+  out.correlation = estimateResidualCorrelation(points, residual, 1, method != UncertaintyMethod::SpatialModel, J);
   const double sse = residual.squaredNorm();
   Eigen::MatrixXd middle;
   if (method == UncertaintyMethod::SpatialModel) {

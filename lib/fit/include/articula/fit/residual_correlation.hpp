@@ -52,8 +52,17 @@ struct ResidualCorrelation {
 /// is taken from a seeded random 2,000 of them; n_eff from all (left at n
 /// with `with_n_eff` false, for a caller that sums the covariance itself:
 /// nEffective).
+///
+/// `fitted_directions` (#P x k, optional): the derivatives of the residuals
+/// with respect to the k parameters of the fit they are left by. The fit
+/// takes up the part of a correlated error that looks like a change of its
+/// parameters, so its residuals' variogram rises more slowly than the
+/// errors'; with them, the model is the one whose errors, less what the fit
+/// takes up, give the residuals' variogram (three rounds of fitting the
+/// variogram divided by what the fit leaves of the model's own).
 ResidualCorrelation estimateResidualCorrelation(const Eigen::MatrixX3d& points, const Eigen::VectorXd& residual,
-                                                unsigned seed = 1, bool with_n_eff = true);
+                                                unsigned seed = 1, bool with_n_eff = true,
+                                                const Eigen::Ref<const Eigen::MatrixXd>& fitted_directions = Eigen::MatrixXd());
 
 /// n_eff = n^2 var / sum_ij cov_ij from the sum of the covariance over
 /// every pair of n points (1^T Sigma 1).

@@ -1,0 +1,50 @@
+#include "articula/testsupport/interval_errors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "articula/geometry/pose.hpp"
+
+namespace articula::fit {
+
+using geometry::ShapeModel;
+
+Eigen::Vector3d semiAxes(const geometry::ShapeParameters& s) {
+  const bool ovoid = s.model == ShapeModel::Ovoid || s.model == ShapeModel::Superovoid;
+  if (s.model == ShapeModel::Sphere) return Eigen::Vector3d::Constant(s.radii[0]);
+  return {s.radii[0] * (ovoid ? s.cx[0] : 1.0), s.radii[1] * (ovoid ? s.cy[0] : 1.0), s.radii[2]};
+}
+
+IntervalErrors intervalErrors(const geometry::ShapeParameters& fitted, const ParameterUncertainty& uncertainty,
+                              const geometry::ShapeParameters& truth, double offset_mm) {
+  const auto names = geometry::parameterNames(fitted.model);
+  auto se_of = [&](const std::string& name) {
+    const auto at = std::find(names.begin(), names.end(), name);
+    return at == names.end() ? NAN : uncertainty.standard_error[at - names.begin()];
+  };
+  IntervalErrors e;
+  for (int i = 0; i < 3; ++i) e.centre_z[i] = (fitted.center[i] - truth.center[i]) / se_of("t" + std::to_string(i + 1));
+  // A sphere has one rotation for any angles: its axes are the truth's.
+  const Eigen::Matrix3d Rt = geometry::rotationFromAngles(truth.angles);
+  const Eigen::Matrix3d Rf = fitted.model == ShapeModel::Sphere ? Rt : geometry::rotationFromAngles(fitted.angles);
+  const Eigen::Vector3d true_semi = semiAxes(truth), semi = semiAxes(fitted);
+  const bool ovoid = fitted.model == ShapeModel::Ovoid || fitted.model == ShapeModel::Superovoid;
+  const char* axis_names[3] = {"a", "b", "c"};
+  for (int i = 0; i < 3; ++i) {
+    // The fitted axis along true axis i.
+    int j = i;
+    if (fitted.model != ShapeModel::Sphere) {
+      j = 0;
+      for (int k = 1; k < 3; ++k)
+        if (std::abs(Rf.col(k).dot(Rt.col(i))) > std::abs(Rf.col(j).dot(Rt.col(i)))) j = k;
+    }
+    double se = se_of(fitted.model == ShapeModel::Sphere ? "a" : axis_names[j]);
+    if (ovoid && j < 2) se *= j == 0 ? fitted.cx[0] : fitted.cy[0];  // of the semi-axis, c0 held
+    e.semi_axis_z[i] = (semi[j] - true_semi[i]) / se;
+    e.semi_axis_less_offset_z[i] = (semi[j] - true_semi[i] - offset_mm) / se;
+  }
+  return e;
+}
+
+}  // namespace articula::fit
