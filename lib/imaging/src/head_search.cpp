@@ -145,8 +145,12 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
     double sse = 0;
     int used = 0;
     c.edge_mm.assign(edges.size(), NAN);
+    c.short_of_sphere.assign(edges.size(), 0);
     for (size_t n = 0; n < edges.size(); ++n) {
-      if (!inlier[n]) continue;
+      if (!inlier[n]) {
+        c.short_of_sphere[n] = !std::isnan(edges[n][0]) && (edges[n] - sphere.center).norm() < sphere.radius;
+        continue;
+      }
       const double residual = (edges[n] - sphere.center).norm() - sphere.radius;
       sse += residual * residual;
       ++used;
@@ -240,13 +244,17 @@ class LatticeLookup {
 
 }  // namespace
 
+Eigen::Vector3d neckSide(Side side) {
+  return Eigen::Vector3d(side == Side::Right ? -1.0 : 1.0, 0.0, -1.0).normalized();
+}
+
 /// The head's edge distance per lattice direction, with the holes of its cap
 /// (a missed edge, the fovea's pit, a flattened dome) filled from their
 /// neighbours: a direction without an edge whose nearest neighbours mostly
 /// have one lies inside the cap, and so does every part without edges but
-/// the largest. The neck's directions, that largest part, stay empty.
-/// `slice_axis`: the grid's slice normal (unit, LPS).
-std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis) {
+/// the neck's whose rays mostly met bone short of the sphere. The neck's
+/// directions stay empty. `slice_axis`: the grid's slice normal (unit, LPS).
+std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis, const Eigen::Vector3d& neck_side) {
   std::vector<double> edge = head.edge_mm;
   constexpr int kNeighbours = 6;
   // The rays within kPoleDeg of the slice axis cross the dome's edge in one
@@ -287,9 +295,14 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
   for (int ring = 0; ring < 2; ++ring) fillRing([](int) { return true; }, kMost);
   for (int ring = 0; ring < 3; ++ring) fillRing([&at_pole](int n) { return at_pole[static_cast<size_t>(n)] != 0; }, kMost);
   // Wider holes the cap's edges enclose (a dome flattened or eroded below
-  // the sphere's band, its rays' edges all outliers) take their rim's mean,
-  // ring by ring: left open, they kept the socket across a gap the closing
-  // bridged. The largest part without edges is the neck's side, left open.
+  // the sphere's band, its rays' edges all short of it) take their rim's
+  // mean, ring by ring: left open, they kept the socket across a gap the
+  // closing bridged. The part that lies most towards the neck's side is the
+  // neck's, left open (not the largest: at 3 mm slices an osteoporotic
+  // head's faint dome can leave more rays without edges than its neck). So
+  // is a hole whose rays mostly found no edge or one beyond the sphere (a
+  // faint dome under the socket's roof, seen along the slices): filled, its
+  // cut took the dome's edge for the socket's and moved the surface there.
   std::vector<int> part(kRayCount, -1), part_size;
   for (int n = 0; n < kRayCount; ++n) {
     if (!std::isnan(edge[static_cast<size_t>(n)]) || part[static_cast<size_t>(n)] >= 0) continue;
@@ -306,8 +319,24 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
     }
   }
   if (part_size.size() > 1) {
-    const int neck = static_cast<int>(std::max_element(part_size.begin(), part_size.end()) - part_size.begin());
-    const auto enclosed = [&part, neck](int n) { return part[static_cast<size_t>(n)] != neck; };
+    std::vector<Eigen::Vector3d> direction(part_size.size(), Eigen::Vector3d::Zero());
+    std::vector<int> short_rays(part_size.size(), 0);
+    for (int n = 0; n < kRayCount; ++n)
+      if (const int q = part[static_cast<size_t>(n)]; q >= 0) {
+        direction[static_cast<size_t>(q)] += geometry::fibonacciDirection(n, kRayCount);
+        short_rays[static_cast<size_t>(q)] += head.short_of_sphere.empty() ? 0 : head.short_of_sphere[static_cast<size_t>(n)];
+      }
+    int neck = 0;
+    for (int q = 1; q < static_cast<int>(direction.size()); ++q)
+      if (direction[static_cast<size_t>(q)].normalized().dot(neck_side) > direction[static_cast<size_t>(neck)].normalized().dot(neck_side))
+        neck = q;
+    std::vector<char> fill(part_size.size(), 0);
+    for (size_t q = 0; q < part_size.size(); ++q)
+      fill[q] = static_cast<int>(q) != neck && 2 * short_rays[q] >= part_size[q];
+    const auto enclosed = [&part, &fill](int n) {
+      const int q = part[static_cast<size_t>(n)];
+      return q >= 0 && fill[static_cast<size_t>(q)] != 0;
+    };
     for (int ring = 0; ring < kRayCount; ++ring)
       if (!fillRing(enclosed, 1)) break;
   }

@@ -46,6 +46,7 @@ struct HeadCandidate {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   double radius = 0, coverage = 0, rms_mm = 0;  // coverage: share of the rays whose edge lies on the sphere
   std::vector<double> edge_mm;                  // per ray of the lattice, from `center`; NaN: no edge on the sphere
+  std::vector<char> short_of_sphere;            // per ray: its edge was found but short of the sphere's band
   double area() const { return coverage * 4 * M_PI * radius * radius; }
   /// Edges on a third of the rays and nearly spherical: a head's cap seen
   /// through a visible gap.
@@ -80,8 +81,12 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
 std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head, const SegmentOptions& options);
 /// The head's edge distance per ray of the lattice, the holes of its cap
 /// filled from their neighbours (the neck's directions stay NaN);
-/// `slice_axis`: the grid's slice normal (unit, LPS).
-std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis);
+/// `slice_axis`: the grid's slice normal (unit, LPS); `neck_side`: where the
+/// neck leaves the head, roughly (unit, LPS; neckSide).
+std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis, const Eigen::Vector3d& neck_side);
+/// Where a femoral or humeral neck leaves its head, roughly: lateral and
+/// inferior (LPS: -x on the right side, +x on the left; -z).
+Eigen::Vector3d neckSide(Side side);
 /// Clears the mask's voxels beyond the head's edges (capEdges) in the directions of its cap.
 void cutBeyondEdges(Image<std::uint8_t>& mask, const HeadCandidate& head, const std::vector<double>& edge);
 
