@@ -544,20 +544,6 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
     for (const double e : each) sum += e;  // in order: the same sum for any thread count
     return sum;
   };
-  // Every third line of `subset` (where that leaves kMinLines): the common
-  // width's coarse grid only brackets its least, which the refinements then
-  // find over every line, as over a grid of every line wherever the two
-  // grids' best samples agree (the estimate takes nine tenths of the mesh
-  // stage's time). Not for the split widths' or the held lines' searches,
-  // whose profiles are flat: thinned, they moved slice widths at 3 mm
-  // slices by 0.02-0.4 mm and surfaces by up to 0.04 mm.
-  const auto thinned = [](const std::vector<size_t>& subset) {
-    constexpr size_t kEvery = 3;
-    if (subset.size() < kEvery * static_cast<size_t>(kMinLines)) return subset;
-    std::vector<size_t> out;
-    for (size_t i = 0; i < subset.size(); i += kEvery) out.push_back(subset[i]);
-    return out;
-  };
   // One width for both directions, for each kind; the kind whose best fits better is kept.
   struct Common {
     bool found = false;
@@ -565,13 +551,11 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
   };
   const auto commonWidth = [&](const std::vector<size_t>& subset, PointSpread::Kind kind) {
     constexpr double kStep = 0.1, kFirst = 0.05, kLast = 2.0, kFineStep = 0.01;
-    const std::vector<size_t> few = thinned(subset);
     const auto f = [&](double s) { return total(subset, kind, s, s); };
-    const auto f_few = [&](double s) { return total(few, kind, s, s); };
     std::vector<double> grid_mm, negated_log_likelihood;
     for (double s = kFirst; s <= kLast + 1e-9; s += kStep) {
       grid_mm.push_back(s);
-      negated_log_likelihood.push_back(f_few(s));
+      negated_log_likelihood.push_back(f(s));
     }
     const auto at = std::min_element(negated_log_likelihood.begin(), negated_log_likelihood.end()) -
                     negated_log_likelihood.begin();
