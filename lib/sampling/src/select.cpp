@@ -72,6 +72,73 @@ void fitPatchSphere(const Eigen::MatrixX3d& V, Selection& patch) {
 // tolerance of the ellipsoid's normal.
 constexpr double kMinEllipsoidBandMm = 0.4;
 
+// The head is convex; the head-neck junction, the fovea's pit and a cyst's
+// or a dent's rim are not. The bands above reach into the junction by up to
+// a band's width (on the robustness matrix the articular points' error to
+// the true surface was 0.2-0.6 mm RMS beyond 120 degrees from the cap's
+// axis, 0.1-0.2 within), and a richer model bends to follow it. The chosen
+// patch therefore keeps only the vertices where the surface, seen at
+// kCurvatureScaleMm (a few voxels: a coarse CT's mesh is rough at one), is
+// not concave: its mean curvature is positive. A model's flattest part
+// (a superellipsoid's face) has low but positive curvature and stays.
+constexpr double kCurvatureScaleMm = 3.0;
+
+/// Each vertex's mean curvature seen at `scale_mm`: the mean over its mesh
+/// neighbours between half the scale and the scale (reached through edges)
+/// of 2 (x_v - x_w) . n_v / |x_w - x_v|^2, which is 1/R on a sphere of radius
+/// R with outward normals and negative where the surface curves inwards;
+/// then averaged over the same neighbourhood once more.
+std::vector<double> meanCurvatureAtScale(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
+                                         double scale_mm) {
+  const Eigen::Index n = V.rows();
+  std::vector<std::vector<int>> adjacent(static_cast<size_t>(n));
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      adjacent[static_cast<size_t>(F(t, k))].push_back(F(t, (k + 1) % 3));
+      adjacent[static_cast<size_t>(F(t, (k + 1) % 3))].push_back(F(t, k));
+    }
+  // Calls visit(w, x_v - x_w) for every vertex w within scale_mm of v that
+  // edges reach without leaving that ball (v itself included).
+  std::vector<long long> seen(static_cast<size_t>(n), -1);
+  long long visit_id = 0;
+  std::vector<int> todo;
+  const double reach2 = scale_mm * scale_mm;
+  const auto forNeighbourhood = [&](Eigen::Index v, const auto& visit) {
+    const Eigen::Vector3d x = V.row(v).transpose();
+    ++visit_id;
+    todo.assign(1, static_cast<int>(v));
+    seen[static_cast<size_t>(v)] = visit_id;
+    while (!todo.empty()) {
+      const int w = todo.back();
+      todo.pop_back();
+      visit(w, Eigen::Vector3d(x - V.row(w).transpose()));
+      for (int u : adjacent[static_cast<size_t>(w)])
+        if (seen[static_cast<size_t>(u)] != visit_id && (V.row(u).transpose() - x).squaredNorm() <= reach2)
+          seen[static_cast<size_t>(u)] = visit_id, todo.push_back(u);
+    }
+  };
+  std::vector<double> raw(static_cast<size_t>(n), NAN), smooth(static_cast<size_t>(n), NAN);
+  for (Eigen::Index v = 0; v < n; ++v) {
+    const Eigen::Vector3d normal = N.row(v).transpose();
+    double sum = 0;
+    int count = 0;
+    forNeighbourhood(v, [&](int, const Eigen::Vector3d& d) {
+      const double d2 = d.squaredNorm();
+      if (d2 >= 0.25 * reach2) sum += 2 * d.dot(normal) / d2, ++count;
+    });
+    if (count > 0) raw[static_cast<size_t>(v)] = sum / count;
+  }
+  for (Eigen::Index v = 0; v < n; ++v) {
+    double sum = 0;
+    int count = 0;
+    forNeighbourhood(v, [&](int w, const Eigen::Vector3d&) {
+      if (!std::isnan(raw[static_cast<size_t>(w)])) sum += raw[static_cast<size_t>(w)], ++count;
+    });
+    if (count > 0) smooth[static_cast<size_t>(v)] = sum / count;
+  }
+  return smooth;
+}
+
 /// The vertices within the patch's ellipsoid band, as the largest connected
 /// patch; `patch` unchanged when no ellipsoid fits it (degenerate or flat).
 std::vector<int> ellipsoidBand(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
@@ -243,6 +310,22 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
         const int found = sel.ransac_spheres;
         sel = patch;
         sel.ransac_spheres = found;
+      }
+    }
+    // Trimmed after the choice among the spheres' patches, which stays on
+    // their bands' sizes: trimmed first, a neighbouring sphere's patch with
+    // less of the junction could outgrow the head's own.
+    if (static_cast<int>(sel.indices.size()) >= std::max(o.min_points, 10)) {
+      const std::vector<double> curvature = meanCurvatureAtScale(V, N, F, kCurvatureScaleMm);
+      std::vector<char> convex(static_cast<size_t>(n), 0);
+      for (int v : sel.indices) convex[static_cast<size_t>(v)] = curvature[static_cast<size_t>(v)] > 0;
+      std::vector<int> kept = largestPatch(convex, F);
+      std::ostringstream m;
+      m << "convex part of the patch: " << sel.indices.size() << " -> " << kept.size() << " vertices";
+      log::debug(m.str());
+      if (static_cast<int>(kept.size()) >= std::max(o.min_points, 10)) {
+        sel.indices = std::move(kept);
+        fitPatchSphere(V, sel);
       }
     }
     if (sel.ransac_spheres == 0) {
