@@ -94,7 +94,8 @@ class SampleCommand : public cli::Command {
       summary["sphere"] = {{"center_mm", {sel.sphere_center[0], sel.sphere_center[1], sel.sphere_center[2]}},
                            {"radius_mm", sel.sphere_radius},
                            {"rms_mm", sel.sphere_rms_mm},
-                           {"ransac_spheres_in_range", sel.ransac_spheres}};
+                           {"ransac_spheres_in_range", sel.ransac_spheres},
+                           {"concave_vertices_left_out", sel.concave_left_out}};
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);
     if (common.json) cli::printJson(summary);
     return 0;

@@ -80,6 +80,7 @@ TEST(Sampling, AnEllipsoidalHeadIsSelectedWithoutItsNeck) {
   // 1 mm band alone took vertices 0.69 mm outside the ellipsoid, the
   // ellipsoid's band 0.34 mm; the convex part stops within 0.001 mm) ...
   EXPECT_LT(worst, 0.05) << "a selected vertex lies " << worst << " mm off the head";
+  EXPECT_GT(sel.concave_left_out, 0);
   // ... and the whole cap is kept, every vertex within 100 degrees of the
   // pole (the sphere's band alone lost 149 of 6,721 where the cap is flattest).
   const Eigen::Vector3d pole = geometry::rotationFromAngles(head.angles).col(2);

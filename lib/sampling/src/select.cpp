@@ -324,6 +324,7 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
       m << "convex part of the patch: " << sel.indices.size() << " -> " << kept.size() << " vertices";
       log::debug(m.str());
       if (static_cast<int>(kept.size()) >= std::max(o.min_points, 10)) {
+        sel.concave_left_out = static_cast<int>(sel.indices.size() - kept.size());
         sel.indices = std::move(kept);
         fitPatchSphere(V, sel);
       }

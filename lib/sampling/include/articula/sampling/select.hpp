@@ -37,6 +37,7 @@ struct Selection {
   double sphere_radius = 0;
   double sphere_rms_mm = 0;                           // RMS radial residual of the patch
   int ransac_spheres = 0;                             // spheres RANSAC found in the radius range
+  int concave_left_out = 0;                           // Auto: the chosen patch's vertices where the surface is concave
 };
 
 /// Selects the articular vertices of a mesh: #V x 3 vertices V (mm), #V x 3
