@@ -87,7 +87,11 @@ constexpr double kCurvatureScaleMm = 3.0;
 /// neighbours between half the scale and the scale (reached through edges)
 /// of 2 (x_v - x_w) . n_v / |x_w - x_v|^2, which is 1/R on a sphere of radius
 /// R with outward normals and negative where the surface curves inwards;
-/// then averaged over the same neighbourhood once more.
+/// then averaged over the same neighbourhood once more. Hand-written: VTK's
+/// vtkCurvatures measures at one ring, where a CT's mesh is rough, and CGAL's
+/// jet fitting (Monge_via_jet_fitting) fits a local surface per vertex; only
+/// the sign of the mean curvature at one scale is needed, which the
+/// neighbours' sag gives.
 std::vector<double> meanCurvatureAtScale(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
                                          double scale_mm) {
   const Eigen::Index n = V.rows();
