@@ -83,8 +83,9 @@ constexpr double kMinEllipsoidBandMm = 0.4;
 // (a superellipsoid's face) has low but positive curvature and stays.
 constexpr double kCurvatureScaleMm = 3.0;
 
-/// Each vertex's mean curvature seen at `scale_mm`: the mean over its mesh
-/// neighbours between half the scale and the scale (reached through edges)
+/// The mean curvature of the vertices `at` (NaN elsewhere) seen at
+/// `scale_mm`: the mean over a vertex's mesh neighbours between half the
+/// scale and the scale (reached through edges)
 /// of 2 (x_v - x_w) . n_v / |x_w - x_v|^2, which is 1/R on a sphere of radius
 /// R with outward normals and negative where the surface curves inwards;
 /// then averaged over the same neighbourhood once more. Hand-written: VTK's
@@ -93,7 +94,7 @@ constexpr double kCurvatureScaleMm = 3.0;
 /// the sign of the mean curvature at one scale is needed, which the
 /// neighbours' sag gives.
 std::vector<double> meanCurvatureAtScale(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
-                                         double scale_mm) {
+                                         const std::vector<int>& at, double scale_mm) {
   const Eigen::Index n = V.rows();
   std::vector<std::vector<int>> adjacent(static_cast<size_t>(n));
   for (Eigen::Index t = 0; t < F.rows(); ++t)
@@ -121,8 +122,15 @@ std::vector<double> meanCurvatureAtScale(const Eigen::MatrixX3d& V, const Eigen:
           seen[static_cast<size_t>(u)] = visit_id, todo.push_back(u);
     }
   };
+  // The sag-based curvature of the vertices the average reaches, each
+  // computed once, when first needed (the patch is part of the mesh).
   std::vector<double> raw(static_cast<size_t>(n), NAN), smooth(static_cast<size_t>(n), NAN);
-  for (Eigen::Index v = 0; v < n; ++v) {
+  std::vector<int> reached;
+  for (int v : at)
+    forNeighbourhood(v, [&](int w, const Eigen::Vector3d&) { reached.push_back(w); });
+  std::sort(reached.begin(), reached.end());
+  reached.erase(std::unique(reached.begin(), reached.end()), reached.end());
+  for (int v : reached) {
     const Eigen::Vector3d normal = N.row(v).transpose();
     double sum = 0;
     int count = 0;
@@ -132,7 +140,7 @@ std::vector<double> meanCurvatureAtScale(const Eigen::MatrixX3d& V, const Eigen:
     });
     if (count > 0) raw[static_cast<size_t>(v)] = sum / count;
   }
-  for (Eigen::Index v = 0; v < n; ++v) {
+  for (int v : at) {
     double sum = 0;
     int count = 0;
     forNeighbourhood(v, [&](int w, const Eigen::Vector3d&) {
@@ -320,7 +328,7 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
     // their bands' sizes: trimmed first, a neighbouring sphere's patch with
     // less of the junction could outgrow the head's own.
     if (static_cast<int>(sel.indices.size()) >= std::max(o.min_points, 10)) {
-      const std::vector<double> curvature = meanCurvatureAtScale(V, N, F, kCurvatureScaleMm);
+      const std::vector<double> curvature = meanCurvatureAtScale(V, N, F, sel.indices, kCurvatureScaleMm);
       std::vector<char> convex(static_cast<size_t>(n), 0);
       for (int v : sel.indices) convex[static_cast<size_t>(v)] = curvature[static_cast<size_t>(v)] > 0;
       std::vector<int> kept = largestPatch(convex, F);
