@@ -1,12 +1,14 @@
 // Departures of a bone's mesh from its fitted head, on an exact sphere mesh
 // reshaped where the answer is known in closed form: a dome flattened by a
-// plane, an outward bump on the cap's rim, a pit at the medial pole.
+// plane, an outward bump on the cap's rim, a pit at the medial pole, a neck
+// rising beyond the rim with and without a lip at the junction.
 #include <cmath>
 
 #include <gtest/gtest.h>
 
 #include "articula/geometry/surface.hpp"
 #include "articula/checks/cap_departures.hpp"
+#include "articula/imaging/image.hpp"
 
 namespace articula::checks {
 namespace {
@@ -169,6 +171,77 @@ TEST(CapDepartures, ANeckRisingOutOfTheHeadBeyondTheRimIsNoFinding) {
     if (angle > 125) c.input.vertices.row(v) += ((angle - 125) / 5 * c.local(v).normalized()).transpose();
   }
   EXPECT_TRUE(capDepartures(c.input).regions.empty());
+}
+
+// A neck rising out of the head from 127 degrees (1 mm every 5 degrees, as
+// above) with a lip at the junction: a bump `lip_mm` high, 4 mm in reach,
+// at 126 degrees, joined to the neck. The CT: 500 HU inside the reshaped
+// surface and 0 outside, or 500 HU everywhere where the bone goes on
+// beyond the mesh (the head's label cut across the neck).
+struct NeckWithLip {
+  Case c;
+  imaging::Volume ct;
+  double lift(const Eigen::Vector3d& unit, double lip_mm) const {
+    const double angle = std::acos(std::clamp(unit.z(), -1.0, 1.0)) * 180 / M_PI;
+    const double at = 126 * M_PI / 180;
+    const double s = (kRadius * unit - kRadius * Eigen::Vector3d(-std::sin(at), 0, std::cos(at))).norm();
+    return (angle > 127 ? (angle - 127) / 5 : 0) + (s < 4 ? lip_mm * (1 - s * s / 16) : 0);
+  }
+  NeckWithLip(double lip_mm, bool bone_beyond) {
+    c.choosePoints(kRadius);  // the points end at 120 degrees
+    for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v) {
+      const Eigen::Vector3d unit = c.local(v).normalized();
+      c.input.vertices.row(v) += (lift(unit, lip_mm) * unit).transpose();
+    }
+    ct.geometry.spacing = Eigen::Vector3d::Constant(1.0);
+    ct.geometry.size = Eigen::Vector3i::Constant(70);
+    ct.geometry.origin = sphere().center - Eigen::Vector3d::Constant(35);
+    ct.voxels.resize(static_cast<size_t>(ct.geometry.voxelCount()));
+    for (int k = 0; k < 70; ++k)
+      for (int j = 0; j < 70; ++j)
+        for (int i = 0; i < 70; ++i) {
+          const Eigen::Vector3d x = ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center;
+          const bool inside = x.norm() < kRadius + lift(x.normalized(), lip_mm);
+          ct.at(i, j, k) = inside || bone_beyond ? 500.0f : 0.0f;
+        }
+    c.input.ct = &ct;
+  }
+};
+
+TEST(CapDepartures, ALipAtTheJunctionIsToldFromTheNeckItJoins) {
+  NeckWithLip lipped(3, false);
+  const CapDepartures d = capDepartures(lipped.c.input);
+  ASSERT_EQ(d.regions.size(), 1u);
+  const DepartingRegion& lip = d.regions[0];
+  EXPECT_EQ(lip.kind, "outward");
+  // Its crest, where it faces out as the head does (slope under tan 25
+  // degrees = 0.466): on the head's side of 127 degrees, within 1.24 mm
+  // of the apex (the bump's slope is 0.375 s); beyond, where the neck's
+  // slope (0.573 along the meridian) and the bump's cancel, within 1.24
+  // mm of a point 1.53 mm past the apex. The two parts of discs: 3.3 +
+  // 4.8 mm^2 on a plane, by ((R + 3) / R)^2 = 1.32 on the sphere, 10.7
+  // mm^2, and the vertices' areas at the border (0.4 mm edges) add up to a
+  // third; their centre about 128.5 degrees from the pole.
+  EXPECT_NEAR(lip.depth_mm, 3.2, 0.2);
+  EXPECT_GT(lip.area_mm2, 10.7);
+  EXPECT_LT(lip.area_mm2, 1.35 * 10.7);
+  EXPECT_NEAR(lip.from_cap_axis_deg, 128.5, 1);
+  EXPECT_EQ(lip.where, "lateral, inferior");
+  EXPECT_NEAR(d.largestFindingMm2(), lip.area_mm2, 1e-9);
+
+  // Without the CT nothing tells the lip from a cut across the neck: the
+  // neck's region is no finding, lip and all.
+  lipped.c.input.ct = nullptr;
+  EXPECT_TRUE(capDepartures(lipped.c.input).regions.empty());
+  // Bone beyond it: the label's cut across the neck, no lip.
+  NeckWithLip cut(3, true);
+  EXPECT_TRUE(capDepartures(cut.c.input).regions.empty());
+  // A lip 2 mm high stands under kLipMinHeightMm: left with the neck.
+  NeckWithLip low(2, false);
+  EXPECT_TRUE(capDepartures(low.c.input).regions.empty());
+  // The neck alone, with its CT.
+  NeckWithLip none(0, false);
+  EXPECT_TRUE(capDepartures(none.c.input).regions.empty());
 }
 
 }  // namespace

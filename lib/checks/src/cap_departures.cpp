@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <Eigen/Geometry>
@@ -10,6 +11,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/fibonacci.hpp"
 #include "articula/geometry/mesh_components.hpp"
+#include "articula/imaging/edges.hpp"
 
 namespace articula::checks {
 namespace {
@@ -129,6 +131,78 @@ void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
   }
 }
 
+// A lip at the head-neck junction (an osteophyte, a cam) joins the neck's
+// outward region, which runs on beyond the rim and is no finding as a
+// whole. What tells the lip from the neck is which way the bone faces: the
+// neck rises out of the head at a slant (its surface faces sideways, about
+// 45 degrees from the direction out of the head's centre), a lip stands
+// out and faces outwards as the head does. So does the face where the
+// head's label was cut across the neck, but the CT's bone goes on beyond
+// it. The vertices of a region reaching beyond the rim that face within
+// kLipTiltDeg of the way out of the centre (`distance`: from the model,
+// per vertex) form parts; a part is a lip when it comes within kLipReachMm
+// of an articular point, has soft tissue beyond it (the CT kLipProbeMm
+// outside below kLipOutsideShare of its value as far inside) and stands
+// kLipMinHeightMm or more above the model (its median vertex). Lips are
+// given parts of their own in `part`, numbered from the count of parts
+// before, which is returned.
+constexpr double kLipTiltDeg = 25;
+constexpr double kLipReachMm = 6;         // a lip's crest lies about 1.4 times its height beyond the cap's edge
+constexpr double kLipProbeMm = 3;
+constexpr double kLipOutsideShare = 0.5;  // 3 mm lips on the clinical bench: 0.08-0.46; cuts across the neck: 0.8-1.1
+// The junction's terraces at 3 mm slices face out up to a median 2.1 mm
+// above the model (the robustness matrix's 64 heads); 3 mm lips stand 2.7-3.3.
+constexpr double kLipMinHeightMm = 2.4;
+
+int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward_normal, const Eigen::Vector3d& c,
+                      const Eigen::MatrixX3d& points, const std::vector<char>& beyond_rim, const Eigen::MatrixX3i& triangles,
+                      const imaging::Volume& ct, const std::vector<double>& distance, std::vector<int>& part) {
+  int first = 0;
+  for (int p : part) first = std::max(first, p + 1);
+  std::vector<char> reaches_beyond(static_cast<size_t>(first), 0);
+  for (size_t v = 0; v < part.size(); ++v)
+    if (part[v] >= 0 && beyond_rim[v]) reaches_beyond[static_cast<size_t>(part[v])] = 1;
+  std::vector<char> facing_out(part.size(), 0);
+  bool any = false;
+  for (size_t v = 0; v < part.size(); ++v) {
+    if (part[v] < 0 || !reaches_beyond[static_cast<size_t>(part[v])]) continue;
+    const auto i = static_cast<Eigen::Index>(v);
+    if (degrees(outward_normal.row(i).transpose(), V.row(i).transpose() - c) < kLipTiltDeg) facing_out[v] = any = 1;
+  }
+  if (!any) return first;
+  const std::vector<int> lip = geometry::connectedParts(facing_out, triangles);
+  int lips = 0;
+  for (int p : lip) lips = std::max(lips, p + 1);
+  // Each part's mean HU kLipProbeMm inside and outside its surface.
+  std::vector<char> near_points(static_cast<size_t>(lips), 0);
+  std::vector<double> hu_in(static_cast<size_t>(lips), 0), hu_out(static_cast<size_t>(lips), 0);
+  std::vector<int> probed(static_cast<size_t>(lips), 0);
+  for (size_t v = 0; v < lip.size(); ++v) {
+    if (lip[v] < 0) continue;
+    const auto p = static_cast<size_t>(lip[v]);
+    const Eigen::Vector3d x = V.row(static_cast<Eigen::Index>(v)).transpose();
+    if (!near_points[p]) near_points[p] = (points.rowwise() - x.transpose()).rowwise().squaredNorm().minCoeff() <= kLipReachMm * kLipReachMm;
+    const Eigen::Vector3d n = outward_normal.row(static_cast<Eigen::Index>(v)).normalized().transpose();
+    const double inside = imaging::interpolate(ct, x - kLipProbeMm * n), outside = imaging::interpolate(ct, x + kLipProbeMm * n);
+    if (!std::isfinite(inside) || !std::isfinite(outside)) continue;
+    hu_in[p] += inside;
+    hu_out[p] += outside;
+    ++probed[p];
+  }
+  std::vector<std::vector<double>> height(static_cast<size_t>(lips));
+  for (size_t v = 0; v < lip.size(); ++v)
+    if (lip[v] >= 0) height[static_cast<size_t>(lip[v])].push_back(distance[v]);
+  // Where the head's label was cut across the neck, the bone goes on
+  // beyond the mesh; beyond a lip lies soft tissue.
+  std::vector<char> is_lip(static_cast<size_t>(lips), 0);
+  for (size_t p = 0; p < is_lip.size(); ++p)
+    is_lip[p] = near_points[p] && probed[p] > 0 && hu_out[p] < kLipOutsideShare * hu_in[p] &&
+                percentile(height[p], 0.5) >= kLipMinHeightMm;
+  for (size_t v = 0; v < lip.size(); ++v)
+    if (lip[v] >= 0 && is_lip[static_cast<size_t>(lip[v])]) part[v] = first + lip[v];
+  return first;
+}
+
 }  // namespace
 
 double CapDepartures::largestFindingMm2() const {
@@ -222,7 +296,9 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
 
   std::vector<int> region_of_vertex(static_cast<size_t>(V.rows()), -1);
   for (const bool is_inward : {true, false}) {
-    const std::vector<int> part = geometry::connectedParts(is_inward ? inward : outward, in.triangles);
+    std::vector<int> part = geometry::connectedParts(is_inward ? inward : outward, in.triangles);
+    const int first_lip = is_inward || !in.ct ? std::numeric_limits<int>::max()
+                                              : splitLipsFromNeck(V, normal * outward_sign, c, in.points, beyond_rim, in.triangles, *in.ct, vertex_distance, part);
     std::vector<DepartingRegion> regions;
     std::vector<char> reaches_beyond;
     for (size_t v = 0; v < part.size(); ++v) {
@@ -242,8 +318,9 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
     for (size_t k = 0; k < regions.size(); ++k) {
       DepartingRegion& region = regions[k];
       // Outwards, a region that runs on beyond the rim is the neck rising
-      // out of the head's surface (or a bone beyond it), not a lip on the rim.
-      if (region.area_mm2 < kMinDepartingRegionMm2 || reaches_beyond[k]) continue;
+      // out of the head's surface (or a bone beyond it); a lip on the neck
+      // at the junction has been given a part of its own above.
+      if (region.area_mm2 < kMinDepartingRegionMm2 || (reaches_beyond[k] && static_cast<int>(k) < first_lip)) continue;
       region.centre /= region.area_mm2;
       region.direction = (region.centre - c).normalized();
       region.from_cap_axis_deg = degrees(region.direction, out.cap_axis);

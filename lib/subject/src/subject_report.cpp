@@ -191,6 +191,7 @@ std::optional<checks::CapDepartures> departuresFromModel(const Eigen::MatrixX3d&
   in.model = model;
   in.points = points;
   if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
+  in.ct = ct;
   // LPS: +x is the patient's left, so a right hip's medial side is +x.
   if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
   return checks::capDepartures(in);

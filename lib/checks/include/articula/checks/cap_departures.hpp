@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "articula/geometry/shape.hpp"
+#include "articula/imaging/image.hpp"
 
 namespace articula::checks {
 
@@ -58,13 +59,16 @@ struct CapDepartureInput {
   Eigen::MatrixX3d points;     // the articular points it was fitted to
   double voxel_mm = 0;         // the CT's largest spacing, if known: the threshold is at least 0.3 voxel
   std::optional<Eigen::Vector3d> medial;  // a hip's medial direction (towards the body's middle): where its fovea lies
+  const imaging::Volume* ct = nullptr;    // the CT the mesh came from, if known: a lip at the junction is sought only with it
 };
 
 /// Measures the mesh's vertices over the cap (angle from the cap's axis up to
 /// its half-angle; inwards) and its rim (up to rim_extension beyond;
 /// outwards), within 0.5-1.5 model radii of the centre and facing outwards,
 /// against the model's exact signed distance. A vertex departs beyond
-/// max(0.75 mm, 3 x the points' robust residual SD, 0.3 voxel).
+/// max(0.75 mm, 3 x the points' robust residual SD, 0.3 voxel). Outward
+/// regions that run on beyond the rim (the neck) are left out, but for a
+/// lip on them at the junction, which is sought with the CT.
 CapDepartures capDepartures(const CapDepartureInput& input);
 
 }  // namespace articula::checks
