@@ -205,6 +205,7 @@ struct NeckWithLip {
           ct.at(i, j, k) = inside || bone_beyond ? 500.0f : 0.0f;
         }
     c.input.ct = &ct;
+    c.input.seek_junction_lip = true;
   }
 };
 
@@ -232,6 +233,10 @@ TEST(CapDepartures, ALipAtTheJunctionIsToldFromTheNeckItJoins) {
   // Without the CT nothing tells the lip from a cut across the neck: the
   // neck's region is no finding, lip and all.
   lipped.c.input.ct = nullptr;
+  EXPECT_TRUE(capDepartures(lipped.c.input).regions.empty());
+  // Nor on a shoulder, whose tuberosities stand out beside its neck.
+  lipped.c.input.ct = &lipped.ct;
+  lipped.c.input.seek_junction_lip = false;
   EXPECT_TRUE(capDepartures(lipped.c.input).regions.empty());
   // Bone beyond it: the label's cut across the neck, no lip.
   NeckWithLip cut(3, true);

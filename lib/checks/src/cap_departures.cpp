@@ -297,7 +297,7 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
   std::vector<int> region_of_vertex(static_cast<size_t>(V.rows()), -1);
   for (const bool is_inward : {true, false}) {
     std::vector<int> part = geometry::connectedParts(is_inward ? inward : outward, in.triangles);
-    const int first_lip = is_inward || !in.ct ? std::numeric_limits<int>::max()
+    const int first_lip = is_inward || !in.ct || !in.seek_junction_lip ? std::numeric_limits<int>::max()
                                               : splitLipsFromNeck(V, normal * outward_sign, c, in.points, beyond_rim, in.triangles, *in.ct, vertex_distance, part);
     std::vector<DepartingRegion> regions;
     std::vector<char> reaches_beyond;

@@ -192,6 +192,7 @@ std::optional<checks::CapDepartures> departuresFromModel(const Eigen::MatrixX3d&
   in.points = points;
   if (ct) in.voxel_mm = ct->geometry.spacing.maxCoeff();
   in.ct = ct;
+  in.seek_junction_lip = joint == "hip";
   // LPS: +x is the patient's left, so a right hip's medial side is +x.
   if (joint == "hip" && (side == "right" || side == "left")) in.medial = Eigen::Vector3d(side == "right" ? 1 : -1, 0, 0);
   return checks::capDepartures(in);

@@ -60,6 +60,10 @@ struct CapDepartureInput {
   double voxel_mm = 0;         // the CT's largest spacing, if known: the threshold is at least 0.3 voxel
   std::optional<Eigen::Vector3d> medial;  // a hip's medial direction (towards the body's middle): where its fovea lies
   const imaging::Volume* ct = nullptr;    // the CT the mesh came from, if known: a lip at the junction is sought only with it
+  // A hip: a lip at the head-neck junction is sought (with the CT). Not on
+  // a shoulder, where the tuberosities beside the anatomical neck stand out
+  // from the head as a lip would.
+  bool seek_junction_lip = false;
 };
 
 /// Measures the mesh's vertices over the cap (angle from the cap's axis up to
@@ -68,7 +72,7 @@ struct CapDepartureInput {
 /// against the model's exact signed distance. A vertex departs beyond
 /// max(0.75 mm, 3 x the points' robust residual SD, 0.3 voxel). Outward
 /// regions that run on beyond the rim (the neck) are left out, but for a
-/// lip on them at the junction, which is sought with the CT.
+/// lip on them at a hip's junction, which is sought with the CT.
 CapDepartures capDepartures(const CapDepartureInput& input);
 
 }  // namespace articula::checks
