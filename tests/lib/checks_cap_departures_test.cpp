@@ -2,6 +2,7 @@
 // reshaped where the answer is known in closed form: a dome flattened by a
 // plane, an outward bump on the cap's rim, a pit at the medial pole, a neck
 // rising beyond the rim with and without a lip at the junction.
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
