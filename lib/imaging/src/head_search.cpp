@@ -254,7 +254,8 @@ Eigen::Vector3d neckSide(Side side) {
 /// have one lies inside the cap, and so does every part without edges but
 /// the neck's whose rays mostly met bone short of the sphere. The neck's
 /// directions stay empty. `slice_axis`: the grid's slice normal (unit, LPS).
-std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis, const Eigen::Vector3d& neck_side) {
+std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis, const Eigen::Vector3d& neck_side,
+                             bool thick_slices) {
   std::vector<double> edge = head.edge_mm;
   constexpr int kNeighbours = 6;
   // The rays within kPoleDeg of the slice axis cross the dome's edge in one
@@ -299,10 +300,13 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
   // mean, ring by ring: left open, they kept the socket across a gap the
   // closing bridged. The part that lies most towards the neck's side is the
   // neck's, left open (not the largest: at 3 mm slices an osteoporotic
-  // head's faint dome can leave more rays without edges than its neck). So
-  // is a hole whose rays mostly found no edge or one beyond the sphere (a
-  // faint dome under the socket's roof, seen along the slices): filled, its
-  // cut took the dome's edge for the socket's and moved the surface there.
+  // head's faint dome can leave more rays without edges than its neck).
+  // Across thick slices, so is a hole whose rays mostly found no edge or one
+  // beyond the sphere (a faint dome under the socket's roof, seen along the
+  // slices): filled, its cut took the dome's edge for the socket's and moved
+  // the surface there. Where the slices are not thick, such a hole is the
+  // socket bridged across a narrow gap (a thin, faint cortex at 0.7 x 0.7 x
+  // 0.9 mm, its gap 1.5 mm): left open, it kept the socket in the label.
   std::vector<int> part(kRayCount, -1), part_size;
   for (int n = 0; n < kRayCount; ++n) {
     if (!std::isnan(edge[static_cast<size_t>(n)]) || part[static_cast<size_t>(n)] >= 0) continue;
@@ -332,7 +336,7 @@ std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& s
         neck = q;
     std::vector<char> fill(part_size.size(), 0);
     for (size_t q = 0; q < part_size.size(); ++q)
-      fill[q] = static_cast<int>(q) != neck && 2 * short_rays[q] >= part_size[q];
+      fill[q] = static_cast<int>(q) != neck && (!thick_slices || 2 * short_rays[q] >= part_size[q]);
     const auto enclosed = [&part, &fill](int n) {
       const int q = part[static_cast<size_t>(n)];
       return q >= 0 && fill[static_cast<size_t>(q)] != 0;

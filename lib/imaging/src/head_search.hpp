@@ -82,8 +82,13 @@ std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head
 /// The head's edge distance per ray of the lattice, the holes of its cap
 /// filled from their neighbours (the neck's directions stay NaN);
 /// `slice_axis`: the grid's slice normal (unit, LPS); `neck_side`: where the
-/// neck leaves the head, roughly (unit, LPS; neckSide).
-std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis, const Eigen::Vector3d& neck_side);
+/// neck leaves the head, roughly (unit, LPS; neckSide); `thick_slices`:
+/// slices more than kThickSliceRatio times the in-plane spacing apart.
+std::vector<double> capEdges(const HeadCandidate& head, const Eigen::Vector3d& slice_axis, const Eigen::Vector3d& neck_side,
+                             bool thick_slices);
+/// Slices more than this many times the in-plane spacing apart blur the dome's
+/// edge along them (capEdges).
+constexpr double kThickSliceRatio = 1.5;
 /// Where a femoral or humeral neck leaves its head, roughly: lateral and
 /// inferior (LPS: -x on the right side, +x on the left; -z).
 Eigen::Vector3d neckSide(Side side);

@@ -339,7 +339,9 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
   // Cut again after the holes are filled: where noise has closed the soft
   // tissue around the head into bone, the shell the first cut opened was a
   // hole, and filling it gave it back.
-  const std::vector<double> cap_edges = measured ? capEdges(head_found, g.direction.col(2), neckSide(options.side)) : std::vector<double>();
+  const bool thick_slices = g.spacing[2] > kThickSliceRatio * std::max(g.spacing[0], g.spacing[1]);
+  const std::vector<double> cap_edges =
+      measured ? capEdges(head_found, g.direction.col(2), neckSide(options.side), thick_slices) : std::vector<double>();
   if (measured) cutBeyondEdges(box_raw, head_found, cap_edges);
   Mask box_mask = fillHoles(box_raw);
   if (measured) cutBeyondEdges(box_mask, head_found, cap_edges);
