@@ -173,15 +173,16 @@ int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward
   const std::vector<int> lip = geometry::connectedParts(facing_out, triangles);
   int lips = 0;
   for (int p : lip) lips = std::max(lips, p + 1);
-  // Each part's mean HU kLipProbeMm inside and outside its surface.
-  std::vector<char> near_points(static_cast<size_t>(lips), 0);
+  // Each part's mean HU kLipProbeMm inside and outside its surface, and its
+  // vertices' heights above the model.
   std::vector<double> hu_in(static_cast<size_t>(lips), 0), hu_out(static_cast<size_t>(lips), 0);
   std::vector<int> probed(static_cast<size_t>(lips), 0);
+  std::vector<std::vector<double>> height(static_cast<size_t>(lips));
   for (size_t v = 0; v < lip.size(); ++v) {
     if (lip[v] < 0) continue;
     const auto p = static_cast<size_t>(lip[v]);
+    height[p].push_back(distance[v]);
     const Eigen::Vector3d x = V.row(static_cast<Eigen::Index>(v)).transpose();
-    if (!near_points[p]) near_points[p] = (points.rowwise() - x.transpose()).rowwise().squaredNorm().minCoeff() <= kLipReachMm * kLipReachMm;
     const Eigen::Vector3d n = outward_normal.row(static_cast<Eigen::Index>(v)).normalized().transpose();
     const double inside = imaging::interpolate(ct, x - kLipProbeMm * n), outside = imaging::interpolate(ct, x + kLipProbeMm * n);
     if (!std::isfinite(inside) || !std::isfinite(outside)) continue;
@@ -189,15 +190,19 @@ int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward
     hu_out[p] += outside;
     ++probed[p];
   }
-  std::vector<std::vector<double>> height(static_cast<size_t>(lips));
-  for (size_t v = 0; v < lip.size(); ++v)
-    if (lip[v] >= 0) height[static_cast<size_t>(lip[v])].push_back(distance[v]);
   // Where the head's label was cut across the neck, the bone goes on
-  // beyond the mesh; beyond a lip lies soft tissue.
+  // beyond the mesh; beyond a lip lies soft tissue. The distance to the
+  // articular points, the costly test, only for the parts that pass these.
   std::vector<char> is_lip(static_cast<size_t>(lips), 0);
   for (size_t p = 0; p < is_lip.size(); ++p)
-    is_lip[p] = near_points[p] && probed[p] > 0 && hu_out[p] < kLipOutsideShare * hu_in[p] &&
-                percentile(height[p], 0.5) >= kLipMinHeightMm;
+    is_lip[p] = probed[p] > 0 && hu_out[p] < kLipOutsideShare * hu_in[p] && percentile(height[p], 0.5) >= kLipMinHeightMm;
+  std::vector<char> near_points(static_cast<size_t>(lips), 0);
+  for (size_t v = 0; v < lip.size(); ++v) {
+    if (lip[v] < 0 || !is_lip[static_cast<size_t>(lip[v])] || near_points[static_cast<size_t>(lip[v])]) continue;
+    const Eigen::RowVector3d x = V.row(static_cast<Eigen::Index>(v));
+    near_points[static_cast<size_t>(lip[v])] = (points.rowwise() - x).rowwise().squaredNorm().minCoeff() <= kLipReachMm * kLipReachMm;
+  }
+  for (size_t p = 0; p < is_lip.size(); ++p) is_lip[p] = is_lip[p] && near_points[p];
   for (size_t v = 0; v < lip.size(); ++v)
     if (lip[v] >= 0 && is_lip[static_cast<size_t>(lip[v])]) part[v] = first + lip[v];
   return first;
