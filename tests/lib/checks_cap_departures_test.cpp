@@ -1,7 +1,8 @@
 // Departures of a bone's mesh from its fitted head, on an exact sphere mesh
 // reshaped where the answer is known in closed form: a dome flattened by a
 // plane, an outward bump on the cap's rim, a pit at the medial pole, a neck
-// rising beyond the rim with and without a lip at the junction.
+// rising beyond the rim with and without a lip at the junction, a raised
+// dome with and without the socket's bone beyond it.
 #include <algorithm>
 #include <cmath>
 
@@ -248,6 +249,56 @@ TEST(CapDepartures, ALipAtTheJunctionIsToldFromTheNeckItJoins) {
   // The neck alone, with its CT.
   NeckWithLip none(0, false);
   EXPECT_TRUE(capDepartures(none.c.input).regions.empty());
+}
+
+// A dome raised 3 mm (6 mm in reach) at the pole, and a CT of 500 HU inside
+// the raised surface and 0 outside; with a socket, bone of 500 HU also from
+// 2 to 10 mm beyond the sphere, so that the raised dome reaches into it:
+// the surface run into the socket across a gap the CT did not show.
+struct RaisedDome {
+  Case c;
+  imaging::Volume ct;
+  explicit RaisedDome(bool socket) {
+    c.choosePoints(kRadius);
+    c.bump(Eigen::Vector3d::UnitZ(), 6, 3);
+    ct.geometry.spacing = Eigen::Vector3d::Constant(1.0);
+    ct.geometry.size = Eigen::Vector3i::Constant(70);
+    ct.geometry.origin = sphere().center - Eigen::Vector3d::Constant(35);
+    ct.voxels.resize(static_cast<size_t>(ct.geometry.voxelCount()));
+    for (int k = 0; k < 70; ++k)
+      for (int j = 0; j < 70; ++j)
+        for (int i = 0; i < 70; ++i) {
+          const Eigen::Vector3d x = ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center;
+          const double s = (x.normalized() * kRadius - kRadius * Eigen::Vector3d::UnitZ()).norm();
+          const bool inside = x.norm() < kRadius + (s < 6 ? 3 * (1 - s * s / 36) : 0);
+          const bool in_socket = socket && x.norm() > kRadius + 2 && x.norm() < kRadius + 10;
+          ct.at(i, j, k) = inside || in_socket ? 500.0f : 0.0f;
+        }
+    c.input.ct = &ct;
+  }
+};
+
+TEST(CapDepartures, ARegionWithBoneBeyondIsTheSurfaceRunIntoItNotTheHeadsBone) {
+  RaisedDome socket(true);
+  const CapDepartures d = capDepartures(socket.c.input);
+  ASSERT_EQ(d.regions.size(), 1u);
+  EXPECT_EQ(d.regions[0].kind, "bone_beyond");
+  EXPECT_NEAR(d.regions[0].depth_mm, 3, 0.05);
+  EXPECT_EQ(d.regions[0].where, "superior");
+  EXPECT_EQ(d.largestFindingMm2(), 0);
+  EXPECT_NEAR(d.largestBoneBeyondMm2(), d.regions[0].area_mm2, 1e-9);
+
+  // Soft tissue beyond: the head's own bone stands out.
+  RaisedDome bare(false);
+  const CapDepartures own = capDepartures(bare.c.input);
+  ASSERT_EQ(own.regions.size(), 1u);
+  EXPECT_EQ(own.regions[0].kind, "outward");
+  EXPECT_NEAR(own.regions[0].area_mm2, d.regions[0].area_mm2, 1e-9);
+  EXPECT_NEAR(own.largestFindingMm2(), own.regions[0].area_mm2, 1e-9);
+  EXPECT_EQ(own.largestBoneBeyondMm2(), 0);
+  // Without the CT nothing tells them apart.
+  socket.c.input.ct = nullptr;
+  EXPECT_EQ(capDepartures(socket.c.input).regions.at(0).kind, "outward");
 }
 
 }  // namespace

@@ -131,6 +131,36 @@ void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
   }
 }
 
+constexpr double kProbeMm = 3;
+constexpr double kSoftTissueShare = 0.5;  // 3 mm lips on the clinical bench: 0.08-0.46; cuts across the neck: 0.8-1.1
+
+// Per part of the vertices (`part`, -1: none; `parts` of them), what lies
+// beyond it: kSoftTissue where the CT's mean kProbeMm outside its vertices
+// (along `outward_normal`) is below kSoftTissueShare of its mean as far
+// inside; kBone where the bone goes on (a neighbouring bone, or one across
+// a joint gap the CT does not resolve); kUnknown where no probe lies in the CT.
+enum Beyond : signed char { kUnknown = -1, kBone = 0, kSoftTissue = 1 };
+std::vector<signed char> whatLiesBeyond(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward_normal, const imaging::Volume& ct,
+                                   const std::vector<int>& part, int parts) {
+  std::vector<double> inside(static_cast<size_t>(parts), 0), outside(static_cast<size_t>(parts), 0);
+  std::vector<int> probed(static_cast<size_t>(parts), 0);
+  for (size_t v = 0; v < part.size(); ++v) {
+    if (part[v] < 0 || part[v] >= parts) continue;
+    const auto p = static_cast<size_t>(part[v]);
+    const Eigen::Vector3d x = V.row(static_cast<Eigen::Index>(v)).transpose();
+    const Eigen::Vector3d n = outward_normal.row(static_cast<Eigen::Index>(v)).normalized().transpose();
+    const double in = imaging::interpolate(ct, x - kProbeMm * n), out = imaging::interpolate(ct, x + kProbeMm * n);
+    if (!std::isfinite(in) || !std::isfinite(out)) continue;
+    inside[p] += in;
+    outside[p] += out;
+    ++probed[p];
+  }
+  std::vector<signed char> beyond(static_cast<size_t>(parts), kUnknown);
+  for (size_t p = 0; p < beyond.size(); ++p)
+    if (probed[p] > 0) beyond[p] = outside[p] < kSoftTissueShare * inside[p] ? kSoftTissue : kBone;
+  return beyond;
+}
+
 // A lip at the head-neck junction (an osteophyte, a cam) joins the neck's
 // outward region, which runs on beyond the rim and is no finding as a
 // whole. What tells the lip from the neck is which way the bone faces: the
@@ -141,15 +171,12 @@ void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
 // it. The vertices of a region reaching beyond the rim that face within
 // kLipTiltDeg of the way out of the centre (`distance`: from the model,
 // per vertex) form parts; a part is a lip when it comes within kLipReachMm
-// of an articular point, has soft tissue beyond it (the CT kLipProbeMm
-// outside below kLipOutsideShare of its value as far inside) and stands
+// of an articular point, has soft tissue beyond it (whatLiesBeyond) and stands
 // kLipMinHeightMm or more above the model (its median vertex). Lips are
 // given parts of their own in `part`, numbered from the count of parts
 // before, which is returned.
 constexpr double kLipTiltDeg = 25;
 constexpr double kLipReachMm = 6;         // a lip's crest lies about 1.4 times its height beyond the cap's edge
-constexpr double kLipProbeMm = 3;
-constexpr double kLipOutsideShare = 0.5;  // 3 mm lips on the clinical bench: 0.08-0.46; cuts across the neck: 0.8-1.1
 // The junction's terraces at 3 mm slices face out up to a median 2.1 mm
 // above the model (the robustness matrix's 64 heads); 3 mm lips stand 2.7-3.3.
 constexpr double kLipMinHeightMm = 2.4;
@@ -173,29 +200,17 @@ int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward
   const std::vector<int> lip = geometry::connectedParts(facing_out, triangles);
   int lips = 0;
   for (int p : lip) lips = std::max(lips, p + 1);
-  // Each part's mean HU kLipProbeMm inside and outside its surface, and its
-  // vertices' heights above the model.
-  std::vector<double> hu_in(static_cast<size_t>(lips), 0), hu_out(static_cast<size_t>(lips), 0);
-  std::vector<int> probed(static_cast<size_t>(lips), 0);
+  // Each part's vertices' heights above the model.
   std::vector<std::vector<double>> height(static_cast<size_t>(lips));
-  for (size_t v = 0; v < lip.size(); ++v) {
-    if (lip[v] < 0) continue;
-    const auto p = static_cast<size_t>(lip[v]);
-    height[p].push_back(distance[v]);
-    const Eigen::Vector3d x = V.row(static_cast<Eigen::Index>(v)).transpose();
-    const Eigen::Vector3d n = outward_normal.row(static_cast<Eigen::Index>(v)).normalized().transpose();
-    const double inside = imaging::interpolate(ct, x - kLipProbeMm * n), outside = imaging::interpolate(ct, x + kLipProbeMm * n);
-    if (!std::isfinite(inside) || !std::isfinite(outside)) continue;
-    hu_in[p] += inside;
-    hu_out[p] += outside;
-    ++probed[p];
-  }
+  for (size_t v = 0; v < lip.size(); ++v)
+    if (lip[v] >= 0) height[static_cast<size_t>(lip[v])].push_back(distance[v]);
   // Where the head's label was cut across the neck, the bone goes on
   // beyond the mesh; beyond a lip lies soft tissue. The distance to the
   // articular points, the costly test, only for the parts that pass these.
+  const std::vector<signed char> beyond = whatLiesBeyond(V, outward_normal, ct, lip, lips);
   std::vector<char> is_lip(static_cast<size_t>(lips), 0);
   for (size_t p = 0; p < is_lip.size(); ++p)
-    is_lip[p] = probed[p] > 0 && hu_out[p] < kLipOutsideShare * hu_in[p] && percentile(height[p], 0.5) >= kLipMinHeightMm;
+    is_lip[p] = beyond[p] == kSoftTissue && percentile(height[p], 0.5) >= kLipMinHeightMm;
   std::vector<char> near_points(static_cast<size_t>(lips), 0);
   for (size_t v = 0; v < lip.size(); ++v) {
     if (lip[v] < 0 || !is_lip[static_cast<size_t>(lip[v])] || near_points[static_cast<size_t>(lip[v])]) continue;
@@ -213,7 +228,14 @@ int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward
 double CapDepartures::largestFindingMm2() const {
   double largest = 0;
   for (const auto& r : regions)
-    if (r.kind != "fovea" && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
+    if ((r.kind == "inward" || r.kind == "outward") && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
+  return largest;
+}
+
+double CapDepartures::largestBoneBeyondMm2() const {
+  double largest = 0;
+  for (const auto& r : regions)
+    if (r.kind == "bone_beyond" && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
   return largest;
 }
 
@@ -319,6 +341,12 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       region.centre += a * V.row(static_cast<Eigen::Index>(v)).transpose();
       region.depth_mm = std::max(region.depth_mm, std::abs(vertex_distance[v]));
     }
+    // Outwards, with the CT: a region with bone going on beyond it is the
+    // surface run into a neighbouring bone (at the dome, the socket across a
+    // gap the CT does not resolve: a narrowed joint, or slices too thick for
+    // the gap), not the head's own bone standing out.
+    const std::vector<signed char> beyond =
+        is_inward || !in.ct ? std::vector<signed char>() : whatLiesBeyond(V, normal * outward_sign, *in.ct, part, static_cast<int>(regions.size()));
     std::vector<int> kept_as(regions.size(), -1);
     for (size_t k = 0; k < regions.size(); ++k) {
       DepartingRegion& region = regions[k];
@@ -331,6 +359,7 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       region.from_cap_axis_deg = degrees(region.direction, out.cap_axis);
       region.where = anatomicalWords(region.direction, in.medial);
       region.kind = is_inward ? "inward" : "outward";
+      if (!beyond.empty() && beyond[k] == kBone) region.kind = "bone_beyond";
       // A hip's fovea capitis: a small pit at the head's medial pole, where
       // the ligament of the head attaches; every femoral head has one.
       if (is_inward && in.medial && degrees(region.direction, *in.medial) <= kFoveaMaxAngleDeg &&

@@ -391,10 +391,9 @@ QcReport checkHead(const HeadQcInput& in) {
       metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
     report.checks.push_back(metal);
   }
-  // Also where the surface is off the bone: at 2.5-3 mm slices a slice's
-  // staircase at the dome departs over 400-480 mm^2 of correct phantom heads,
-  // and an unresolved narrowed joint lifts the surface there (only this
-  // check names it): a doubtful warning rather than a silent error.
+  // Also where the surface is off the bone (a slice too many at thick
+  // slices; a narrowed joint whose socket is dim beside the cortex): a
+  // doubtful warning rather than a silent error.
   if (in.cap_departure_mm2) {
     // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
     QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
@@ -406,6 +405,20 @@ QcReport checkHead(const HeadQcInput& in) {
                         "taken in, a slice too many at coarse slices), or a head no model of the hierarchy follows there; "
                         "the model describes the rest (see cap_departures in results.json and the slices)";
     report.checks.push_back(departs);
+  }
+  // Outward regions with bone going on beyond them are no departure of the
+  // head's bone: the surface ran into a neighbouring bone. At 2.5-3 mm
+  // slices over a 2 mm gap the socket's roof joins the dome (395 mm^2 of a
+  // correct phantom head); a narrowed joint does the same at any slices.
+  if (in.cap_bone_beyond_mm2) {
+    QcCheck joined = grade("cap_bone_beyond_mm2", *in.cap_bone_beyond_mm2, kDepartureWarnMm2, std::nullopt, false,
+                           "the surface runs into bone beyond the head over part of its cap: the largest region "
+                           "departing outwards by " + number(kFindingDepthMm) + " mm or more with bone beyond it (mm^2) is");
+    if (joined.status == "warn")
+      joined.reason += ": the joint gap is not resolved there (a narrowed joint, or slices too thick for the gap) or a "
+                       "neighbouring bone was taken into the head's label; the mesh there is not the head's surface "
+                       "(see cap_departures in results.json and the slices)";
+    report.checks.push_back(joined);
   }
   if (in.surface_on_ct_edges)
     report.checks.push_back(flag("surface_on_ct_edges", *in.surface_on_ct_edges,

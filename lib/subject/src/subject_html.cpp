@@ -174,7 +174,10 @@ std::string departuresSection(const json& results) {
       at += (i ? ", " : "") + fixed(centre[static_cast<size_t>(i)].is_number() ? centre[static_cast<size_t>(i)].get<double>() : NAN, 1);
     const std::string kind = text(r, "kind");
     html += "<tr><td>departure_" + std::to_string(++k) + "</td><td>" +
-            report::escapeMarkup(kind == "fovea" ? "fovea (a pit at the medial pole: anatomy)" : kind) + "</td><td>" +
+            report::escapeMarkup(kind == "fovea"         ? "fovea (a pit at the medial pole: anatomy)"
+                                 : kind == "bone_beyond" ? "outward, bone beyond (run into a neighbouring bone: no gap seen)"
+                                                         : kind) +
+            "</td><td>" +
             fixed(numberAt(r, "area_mm2"), 0) + "</td><td>" + fixed(numberAt(r, "depth_mm"), 1) + "</td><td>" +
             report::escapeMarkup(text(r, "where")) + "</td><td>" + at + "</td></tr>\n";
   }

@@ -20,7 +20,11 @@
 namespace articula::checks {
 
 struct DepartingRegion {
-  std::string kind;        // "inward", "outward", or "fovea" (a hip's inward pit at the medial pole: normal anatomy)
+  // "inward", "outward", "fovea" (a hip's inward pit at the medial pole:
+  // normal anatomy) or "bone_beyond" (outward, with the CT's bone going on
+  // beyond it: the surface run into a neighbouring bone, such as the socket
+  // across a joint gap the CT does not resolve).
+  std::string kind;
   double area_mm2 = 0;     // the mesh area of its vertices
   double depth_mm = 0;     // its largest distance from the model (positive, in either direction)
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // area-weighted mean of its vertices (LPS mm)
@@ -37,9 +41,11 @@ struct CapDepartures {
   double cap_area_mm2 = 0;                             // mesh area measured within the cap
   std::vector<DepartingRegion> regions;                // area at least kMinDepartingRegionMm2, largest first
   std::vector<int> region_of_vertex;                   // per mesh vertex: its index in `regions`, or -1
-  /// The largest area among regions that are not a fovea and depart by
-  /// kFindingDepthMm or more (0 if none).
+  /// The largest area among inward and outward regions departing by
+  /// kFindingDepthMm or more (0 if none): the bone's own departures.
   double largestFindingMm2() const;
+  /// The same among "bone_beyond" regions.
+  double largestBoneBeyondMm2() const;
   nlohmann::json toJson() const;
 };
 
@@ -59,7 +65,7 @@ struct CapDepartureInput {
   Eigen::MatrixX3d points;     // the articular points it was fitted to
   double voxel_mm = 0;         // the CT's largest spacing, if known: the threshold is at least 0.3 voxel
   std::optional<Eigen::Vector3d> medial;  // a hip's medial direction (towards the body's middle): where its fovea lies
-  const imaging::Volume* ct = nullptr;    // the CT the mesh came from, if known: a lip at the junction is sought only with it
+  const imaging::Volume* ct = nullptr;    // the CT the mesh came from, if known: lips at the junction and bone beyond are told only with it
   // A hip: a lip at the head-neck junction is sought (with the CT). Not on
   // a shoulder, where the tuberosities beside the anatomical neck stand out
   // from the head as a lip would.
@@ -72,7 +78,8 @@ struct CapDepartureInput {
 /// against the model's exact signed distance. A vertex departs beyond
 /// max(0.75 mm, 3 x the points' robust residual SD, 0.3 voxel). Outward
 /// regions that run on beyond the rim (the neck) are left out, but for a
-/// lip on them at a hip's junction, which is sought with the CT.
+/// lip on them at a hip's junction, which is sought with the CT. With the
+/// CT, an outward region with bone beyond it is of kind "bone_beyond".
 CapDepartures capDepartures(const CapDepartureInput& input);
 
 }  // namespace articula::checks
