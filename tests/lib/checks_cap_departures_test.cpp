@@ -301,5 +301,23 @@ TEST(CapDepartures, ARegionWithBoneBeyondIsTheSurfaceRunIntoItNotTheHeadsBone) {
   EXPECT_EQ(capDepartures(socket.c.input).regions.at(0).kind, "outward");
 }
 
+// The dome merged with the socket across thick slices: the points a band
+// from 30 degrees below the equator to 24 above, so that the part without
+// points about the pole (66 degrees around it) is larger than the neck's
+// (60 degrees around the other pole).
+TEST(CapDepartures, OnAHipThePartBeyondIsTheNecksSideThoughTheDomeLeftOutIsLarger) {
+  RaisedDome merged(true);
+  merged.c.choosePoints(0.4 * kRadius);
+  const CapDepartures d = capDepartures(merged.c.input);
+  ASSERT_EQ(d.regions.size(), 1u);
+  EXPECT_EQ(d.regions[0].kind, "bone_beyond");
+  EXPECT_EQ(d.regions[0].where, "superior");
+  EXPECT_NEAR(d.regions[0].depth_mm, 3, 0.05);
+  // Without a hip's sides the larger part, the dome's, is taken for the
+  // neck's side, and nothing over it is measured.
+  merged.c.input.medial.reset();
+  EXPECT_TRUE(capDepartures(merged.c.input).regions.empty());
+}
+
 }  // namespace
 }  // namespace articula::checks

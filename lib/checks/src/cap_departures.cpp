@@ -19,6 +19,7 @@ namespace {
 constexpr double kRimExtensionDeg = 15;   // osteophytes grow at the cap's margin, beyond its points
 constexpr int kCapDirections = 3000;     // about 3.7 degrees apart
 constexpr double kChannelDeg = 8;        // half the narrowest channel that joins a hole to the part beyond
+constexpr double kNeckPartShare = 0.25;  // of the largest part without points: a hip's part beyond is the one of these towards its neck
 constexpr double kThresholdFloorMm = 0.75;
 constexpr double kFoveaMaxAngleDeg = 45;  // from the medial direction
 constexpr double kFoveaMaxAreaMm2 = 250, kFoveaMaxDepthMm = 5;
@@ -53,7 +54,8 @@ std::string anatomicalWords(const Eigen::Vector3d& d, const std::optional<Eigen:
 // of directions, those holding a point's direction, and every hole they
 // enclose (a dome or a fovea the selection left out, gaps between sparse
 // points); beyond it, the largest part without points (the neck's side;
-// holes joined to it by a narrow channel stay holes), whose directions
+// on a hip, of the large ones, the one towards the neck; holes joined to
+// it by a narrow channel stay holes), whose directions
 // within kRimExtensionDeg of the cap are its rim.
 struct CapDirections {
   static constexpr char kCap = 0, kRim = 1, kBeyond = 2;
@@ -66,7 +68,7 @@ struct CapDirections {
   }
 };
 
-CapDirections capDirections(const Eigen::MatrixX3d& unit_points) {
+CapDirections capDirections(const Eigen::MatrixX3d& unit_points, const std::optional<Eigen::Vector3d>& neck_side) {
   CapDirections cap;
   const int n = kCapDirections;
   cap.directions.resize(n, 3);
@@ -99,7 +101,20 @@ CapDirections capDirections(const Eigen::MatrixX3d& unit_points) {
   std::vector<int> size(static_cast<size_t>(n), 0);
   for (int p : part)
     if (p >= 0) ++size[static_cast<size_t>(p)];
-  const int largest = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  int largest = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  // A hip's dome merged with its socket across thick slices leaves a part
+  // without points at the pole as large as the neck's: the part beyond is
+  // then the one towards the neck's side, and the dome a hole of the cap.
+  if (neck_side && size[static_cast<size_t>(largest)] > 0) {
+    std::vector<Eigen::Vector3d> sum(static_cast<size_t>(n), Eigen::Vector3d::Zero());
+    for (int i = 0; i < n; ++i)
+      if (part[static_cast<size_t>(i)] >= 0) sum[static_cast<size_t>(part[static_cast<size_t>(i)])] += cap.directions.row(i).transpose();
+    double best = -2;
+    for (int p = 0; p < n; ++p)
+      if (size[static_cast<size_t>(p)] >= kNeckPartShare * size[static_cast<size_t>(largest)] &&
+          sum[static_cast<size_t>(p)].normalized().dot(*neck_side) > best)
+        best = sum[static_cast<size_t>(p)].normalized().dot(*neck_side), largest = p;
+  }
   std::vector<char> beyond(static_cast<size_t>(n), 0);
   if (size[static_cast<size_t>(largest)] > 0)
     for (int i = 0; i < n; ++i)
@@ -270,7 +285,10 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
   for (Eigen::Index i = 0; i < u.rows(); ++i) angles[static_cast<size_t>(i)] = degrees(u.row(i).transpose(), out.cap_axis);
   out.cap_half_angle_deg = percentile(angles, 0.98);
   out.rim_extension_deg = kRimExtensionDeg;
-  const CapDirections cap = capDirections(u);
+  // A hip's neck leaves its head laterally and downwards.
+  std::optional<Eigen::Vector3d> neck_side;
+  if (in.medial) neck_side = (-*in.medial - Eigen::Vector3d::UnitZ()).normalized();
+  const CapDirections cap = capDirections(u, neck_side);
 
   // The points' own scatter about the model: a departure must exceed it.
   const Eigen::VectorXd residual = distance::signedDistances(in.model, in.points);
