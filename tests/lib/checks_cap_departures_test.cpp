@@ -5,6 +5,7 @@
 // dome with and without the socket's bone beyond it.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -175,6 +176,21 @@ TEST(CapDepartures, ANeckRisingOutOfTheHeadBeyondTheRimIsNoFinding) {
   EXPECT_TRUE(capDepartures(c.input).regions.empty());
 }
 
+// A CT of 1 mm voxels over the sphere and 15 mm about it: 500 HU where
+// `bone` holds (of the position relative to the sphere's centre), 0 elsewhere.
+imaging::Volume ctAbout(const std::function<bool(const Eigen::Vector3d&)>& bone) {
+  imaging::Volume ct;
+  ct.geometry.spacing = Eigen::Vector3d::Constant(1.0);
+  ct.geometry.size = Eigen::Vector3i::Constant(70);
+  ct.geometry.origin = sphere().center - Eigen::Vector3d::Constant(35);
+  ct.voxels.resize(static_cast<size_t>(ct.geometry.voxelCount()));
+  for (int k = 0; k < 70; ++k)
+    for (int j = 0; j < 70; ++j)
+      for (int i = 0; i < 70; ++i)
+        ct.at(i, j, k) = bone(ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center) ? 500.0f : 0.0f;
+  return ct;
+}
+
 // A neck rising out of the head from 127 degrees (1 mm every 5 degrees, as
 // above) with a lip at the junction: a bump `lip_mm` high, 4 mm in reach,
 // at 126 degrees, joined to the neck. The CT: 500 HU inside the reshaped
@@ -195,17 +211,7 @@ struct NeckWithLip {
       const Eigen::Vector3d unit = c.local(v).normalized();
       c.input.vertices.row(v) += (lift(unit, lip_mm) * unit).transpose();
     }
-    ct.geometry.spacing = Eigen::Vector3d::Constant(1.0);
-    ct.geometry.size = Eigen::Vector3i::Constant(70);
-    ct.geometry.origin = sphere().center - Eigen::Vector3d::Constant(35);
-    ct.voxels.resize(static_cast<size_t>(ct.geometry.voxelCount()));
-    for (int k = 0; k < 70; ++k)
-      for (int j = 0; j < 70; ++j)
-        for (int i = 0; i < 70; ++i) {
-          const Eigen::Vector3d x = ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center;
-          const bool inside = x.norm() < kRadius + lift(x.normalized(), lip_mm);
-          ct.at(i, j, k) = inside || bone_beyond ? 500.0f : 0.0f;
-        }
+    ct = ctAbout([&](const Eigen::Vector3d& x) { return bone_beyond || x.norm() < kRadius + lift(x.normalized(), lip_mm); });
     c.input.ct = &ct;
     c.input.seek_junction_lip = true;
   }
@@ -261,19 +267,11 @@ struct RaisedDome {
   explicit RaisedDome(bool socket) {
     c.choosePoints(kRadius);
     c.bump(Eigen::Vector3d::UnitZ(), 6, 3);
-    ct.geometry.spacing = Eigen::Vector3d::Constant(1.0);
-    ct.geometry.size = Eigen::Vector3i::Constant(70);
-    ct.geometry.origin = sphere().center - Eigen::Vector3d::Constant(35);
-    ct.voxels.resize(static_cast<size_t>(ct.geometry.voxelCount()));
-    for (int k = 0; k < 70; ++k)
-      for (int j = 0; j < 70; ++j)
-        for (int i = 0; i < 70; ++i) {
-          const Eigen::Vector3d x = ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center;
-          const double s = (x.normalized() * kRadius - kRadius * Eigen::Vector3d::UnitZ()).norm();
-          const bool inside = x.norm() < kRadius + (s < 6 ? 3 * (1 - s * s / 36) : 0);
-          const bool in_socket = socket && x.norm() > kRadius + 2 && x.norm() < kRadius + 10;
-          ct.at(i, j, k) = inside || in_socket ? 500.0f : 0.0f;
-        }
+    ct = ctAbout([socket](const Eigen::Vector3d& x) {
+      const double s = (x.normalized() * kRadius - kRadius * Eigen::Vector3d::UnitZ()).norm();
+      const bool inside = x.norm() < kRadius + (s < 6 ? 3 * (1 - s * s / 36) : 0);
+      return inside || (socket && x.norm() > kRadius + 2 && x.norm() < kRadius + 10);
+    });
     c.input.ct = &ct;
   }
 };
