@@ -5,7 +5,8 @@
 // off the CT's edges at coarse voxels, a socket's outer surface that faces
 // no socket, a head on the body's midline); a cortex blurred away across
 // the slices warns, and so do a head at the other joint's distance from
-// the body's middle and a field of view that ends inside the head.
+// the body's middle, a field of view that ends inside the head and a
+// surface run into bone beyond the head.
 #include <cmath>
 #include <functional>
 
@@ -264,6 +265,24 @@ TEST(HeadQc, MetalNearTheHeadWarns) {
   EXPECT_EQ(r.status, "warn");
   in.metal_near_head_mm3 = 0;
   EXPECT_EQ(check(checks::checkHead(in), "metal_near_head_mm3").status, "pass");
+}
+
+TEST(HeadQc, TheSurfaceRunIntoBoneBeyondWarnsByItsOwnNameAndIsNoDoubtOfThePoints) {
+  // A departure of the bone and a region with bone beyond it, each over
+  // 395 mm^2 (the socket's roof a thick-sliced phantom head's pole took).
+  checks::HeadQcInput in = cap(23, 85);
+  in.cap_bone_beyond_mm2 = 395;
+  const checks::QcReport r = checks::checkHead(in);
+  EXPECT_EQ(check(r, "cap_bone_beyond_mm2").status, "warn");
+  EXPECT_NE(check(r, "cap_bone_beyond_mm2").reason.find("joint gap is not resolved"), std::string::npos);
+  EXPECT_EQ(r.status, "warn");
+  // With a doubt about the structure (a search centre 0.2 radii away) it
+  // does not fail the head: the band of points leaves such regions out.
+  in.search_center = in.sphere_center + Eigen::Vector3d(0, 0.2 * 23, 0);
+  in.search_radius_mm = 23;
+  EXPECT_EQ(checks::checkHead(in).status, "warn");
+  in.cap_bone_beyond_mm2 = 30;  // under 40 mm^2
+  EXPECT_EQ(check(checks::checkHead(in), "cap_bone_beyond_mm2").status, "pass");
 }
 
 TEST(HeadQc, TwoDoubtsTogetherFail) {

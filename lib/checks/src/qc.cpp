@@ -414,6 +414,9 @@ QcReport checkHead(const HeadQcInput& in) {
     QcCheck joined = grade("cap_bone_beyond_mm2", *in.cap_bone_beyond_mm2, kDepartureWarnMm2, std::nullopt, false,
                            "the surface runs into bone beyond the head over part of its cap: the largest region "
                            "departing outwards by " + number(kFindingDepthMm) + " mm or more with bone beyond it (mm^2) is");
+    // Of the mesh, not of the points the fit takes (the band around the head
+    // leaves such regions out), as the same regions were as departures.
+    joined.of_structure = false;
     if (joined.status == "warn")
       joined.reason += ": the joint gap is not resolved there (a narrowed joint, or slices too thick for the gap) or a "
                        "neighbouring bone was taken into the head's label; the mesh there is not the head's surface "
