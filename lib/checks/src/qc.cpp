@@ -391,38 +391,39 @@ QcReport checkHead(const HeadQcInput& in) {
       metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
     report.checks.push_back(metal);
   }
-  // Also where the surface is off the bone (a slice too many at thick
-  // slices; a narrowed joint whose socket is dim beside the cortex): a
-  // doubtful warning rather than a silent error.
-  if (in.cap_departure_mm2) {
-    // Of the bone, not of the structure: a flattened dome or an osteophyte is a finding.
-    QcCheck departs = grade("cap_departure_mm2", *in.cap_departure_mm2, kDepartureWarnMm2, std::nullopt, false,
-                            "the bone departs from the selected model over part of its cap: the largest region "
-                            "departing by " + number(kFindingDepthMm) + " mm or more (mm^2, a hip's fovea aside) is");
-    departs.of_structure = false;
-    if (departs.status == "warn")
-      departs.reason += ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone "
-                        "taken in, a slice too many at coarse slices), or a head no model of the hierarchy follows there; "
-                        "the model describes the rest (see cap_departures in results.json and the slices)";
-    report.checks.push_back(departs);
-  }
+  // Regions of the cap off the model (cap_departures.hpp) warn from
+  // kDepartureWarnMm2 and are no doubt about the structure: the band of
+  // points the fit takes leaves them out.
+  const auto capRegions = [](const std::string& name, double area_mm2, const std::string& what, const std::string& why) {
+    QcCheck check = grade(name, area_mm2, kDepartureWarnMm2, std::nullopt, false, what);
+    check.of_structure = false;
+    if (check.status == "warn") check.reason += why;
+    return check;
+  };
+  // A finding of the bone (a flattened dome, an osteophyte); also where the
+  // surface is off the bone (a slice too many at thick slices; a narrowed
+  // joint whose socket is dim beside the cortex): a doubtful warning
+  // rather than a silent error.
+  if (in.cap_departure_mm2)
+    report.checks.push_back(capRegions(
+        "cap_departure_mm2", *in.cap_departure_mm2,
+        "the bone departs from the selected model over part of its cap: the largest region departing by " +
+            number(kFindingDepthMm) + " mm or more (mm^2, a hip's fovea aside) is",
+        ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone taken in, a "
+        "slice too many at coarse slices), or a head no model of the hierarchy follows there; the model describes "
+        "the rest (see cap_departures in results.json and the slices)"));
   // Outward regions with bone going on beyond them are no departure of the
   // head's bone: the surface ran into a neighbouring bone. At 2.5-3 mm
   // slices over a 2 mm gap the socket's roof joins the dome (395 mm^2 of a
   // correct phantom head); a narrowed joint does the same at any slices.
-  if (in.cap_bone_beyond_mm2) {
-    QcCheck joined = grade("cap_bone_beyond_mm2", *in.cap_bone_beyond_mm2, kDepartureWarnMm2, std::nullopt, false,
-                           "the surface runs into bone beyond the head over part of its cap: the largest region "
-                           "departing outwards by " + number(kFindingDepthMm) + " mm or more with bone beyond it (mm^2) is");
-    // Of the mesh, not of the points the fit takes (the band around the head
-    // leaves such regions out), as the same regions were as departures.
-    joined.of_structure = false;
-    if (joined.status == "warn")
-      joined.reason += ": the joint gap is not resolved there (a narrowed joint, or slices too thick for the gap) or a "
-                       "neighbouring bone was taken into the head's label; the mesh there is not the head's surface "
-                       "(see cap_departures in results.json and the slices)";
-    report.checks.push_back(joined);
-  }
+  if (in.cap_bone_beyond_mm2)
+    report.checks.push_back(capRegions(
+        "cap_bone_beyond_mm2", *in.cap_bone_beyond_mm2,
+        "the surface runs into bone beyond the head over part of its cap: the largest region departing outwards by " +
+            number(kFindingDepthMm) + " mm or more with bone beyond it (mm^2) is",
+        ": the joint gap is not resolved there (a narrowed joint, or slices too thick for the gap) or a neighbouring "
+        "bone was taken into the head's label; the mesh there is not the head's surface (see cap_departures in "
+        "results.json and the slices)"));
   if (in.surface_on_ct_edges)
     report.checks.push_back(flag("surface_on_ct_edges", *in.surface_on_ct_edges,
                                  "warn when the surface could not be moved onto the CT's bone edges",
