@@ -109,11 +109,13 @@ CapDirections capDirections(const Eigen::MatrixX3d& unit_points, const std::opti
     std::vector<Eigen::Vector3d> sum(static_cast<size_t>(n), Eigen::Vector3d::Zero());
     for (int i = 0; i < n; ++i)
       if (part[static_cast<size_t>(i)] >= 0) sum[static_cast<size_t>(part[static_cast<size_t>(i)])] += cap.directions.row(i).transpose();
+    const int biggest = largest;
     double best = -2;
-    for (int p = 0; p < n; ++p)
-      if (size[static_cast<size_t>(p)] >= kNeckPartShare * size[static_cast<size_t>(largest)] &&
-          sum[static_cast<size_t>(p)].normalized().dot(*neck_side) > best)
-        best = sum[static_cast<size_t>(p)].normalized().dot(*neck_side), largest = p;
+    for (int p = 0; p < n; ++p) {
+      if (size[static_cast<size_t>(p)] < kNeckPartShare * size[static_cast<size_t>(biggest)]) continue;
+      const double towards_neck = sum[static_cast<size_t>(p)].normalized().dot(*neck_side);
+      if (towards_neck > best) best = towards_neck, largest = p;
+    }
   }
   std::vector<char> beyond(static_cast<size_t>(n), 0);
   if (size[static_cast<size_t>(largest)] > 0)
@@ -240,18 +242,24 @@ int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward
 
 }  // namespace
 
-double CapDepartures::largestFindingMm2() const {
+namespace {
+// The largest area among `regions` of a kind `of` admits departing by
+// kFindingDepthMm or more (0 if none).
+template <class Kinds>
+double largestDeepMm2(const std::vector<DepartingRegion>& regions, Kinds of) {
   double largest = 0;
   for (const auto& r : regions)
-    if ((r.kind == "inward" || r.kind == "outward") && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
+    if (of(r.kind) && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
   return largest;
+}
+}  // namespace
+
+double CapDepartures::largestFindingMm2() const {
+  return largestDeepMm2(regions, [](const std::string& kind) { return kind == "inward" || kind == "outward"; });
 }
 
 double CapDepartures::largestBoneBeyondMm2() const {
-  double largest = 0;
-  for (const auto& r : regions)
-    if (r.kind == "bone_beyond" && r.depth_mm >= kFindingDepthMm) largest = std::max(largest, r.area_mm2);
-  return largest;
+  return largestDeepMm2(regions, [](const std::string& kind) { return kind == "bone_beyond"; });
 }
 
 nlohmann::json CapDepartures::toJson() const {
