@@ -12,13 +12,15 @@
 // departure from the nearest simpler model on its exact cap, each model's
 // RMS, the true model's fitted from the truth, the models the points leave
 // undetermined, the two selections, and the errors of each fit containing
-// the truth in its standard errors); then per rule and true model the share
+// the truth in its standard errors, the true model's own fit's parameters
+// with the truth's and their standard errors); then per rule and true model the share
 // right, richer than the truth (the test's false positives) and simpler or
 // beside it (an ovoid for a superellipsoid); and the power: the share right
 // by the truth's departure from its simpler models over the noise; and the
 // coverage of the 95 % intervals (fit/uncertainty.hpp's default, the fit's
 // own variogram) of the centre and semi-axes, of the true model's own fit
-// and of every fit containing it. Every
+// and of every fit containing it, and of ovoids' and superovoids' own fits
+// by where their egg terms c1 lie against the bound c1 >= 0. Every
 // cap is seeded: a line is reproduced from its seed.
 //   bench-selection-caps [--caps 200] [--jobs 2] [--seed 1] [--length 4] [--true MODEL]
 #include <algorithm>
@@ -90,6 +92,13 @@ int main(int argc, char** argv) {
         line["rms_mm"][articula::geometry::modelName(f.parameters.model)] = std::sqrt(f.sse_mm2 / s.points);
         if (!f.uncertainty.not_identifiable.empty())
           line["not_identifiable"][articula::geometry::modelName(f.parameters.model)] = f.uncertainty.not_identifiable;
+        if (f.parameters.model == model) {
+          const auto names = articula::geometry::parameterNames(model);
+          const Eigen::VectorXd fitted = articula::geometry::toVector(f.parameters), truth_v = articula::geometry::toVector(truth);
+          for (size_t q = 0; q < names.size(); ++q)
+            line["own"][names[q]] = {fitted[static_cast<Eigen::Index>(q)], truth_v[static_cast<Eigen::Index>(q)],
+                                     f.uncertainty.standard_error[static_cast<Eigen::Index>(q)]};
+        }
         if (articula::geometry::contains(f.parameters.model, model)) {
           const auto z = articula::fit::intervalErrors(f.parameters, f.uncertainty, truth);
           line["z"][articula::geometry::modelName(f.parameters.model)] = {
@@ -178,6 +187,32 @@ int main(int argc, char** argv) {
     }
     std::printf("| %s | %.1f / %.1f %% | %.1f / %.1f %% |\n", name.c_str(), share(own[0]), share(own[1]), share(every[0]),
                 share(every[1]));
+  }
+  // The egg terms' lower bound (c1 >= 0, thesis section 3.2.5): the own
+  // fits of ovoids and superovoids by whether an egg term c1 ends on it or
+  // its interval reaches it (the likelihood cut there), or both lie clear.
+  std::printf("\nown fits by the egg terms' bound c1 >= 0 (centre and semi-axes together):\n"
+              "| true | c1x or c1y on 0 | an interval reaching 0 | both clear |\n|---|---|---|---|\n");
+  for (ShapeModel model : {ShapeModel::Ovoid, ShapeModel::Superovoid}) {
+    const std::string name = articula::geometry::modelName(model);
+    std::vector<double> by[3];
+    for (const auto& line : lines) {
+      if (!line.is_object() || line.value("true", "") != name || !line.contains("own") || !line.contains("z") ||
+          !line["z"].contains(name))
+        continue;
+      int group = 2;
+      for (const char* c1 : {"c1x", "c1y"}) {
+        const auto& v = line["own"][c1];  // fitted, true, standard error
+        const double fitted = v[0].get<double>(), se = v[2].is_number() ? v[2].get<double>() : INFINITY;
+        if (fitted < 1e-6) group = 0;
+        else if (fitted - 1.96 * se < 0.0) group = std::min(group, 1);
+      }
+      for (const char* part : {"centre", "semi_axes"})
+        for (const auto& z : line["z"][name][part])
+          if (z.is_number()) by[group].push_back(z.get<double>());
+    }
+    std::printf("| %s | %.1f %% of %zu | %.1f %% of %zu | %.1f %% of %zu |\n", name.c_str(), share(by[0]), by[0].size() / 6,
+                share(by[1]), by[1].size() / 6, share(by[2]), by[2].size() / 6);
   }
   return 0;
 }
