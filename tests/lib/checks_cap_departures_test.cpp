@@ -299,6 +299,31 @@ TEST(CapDepartures, ARegionWithBoneBeyondIsTheSurfaceRunIntoItNotTheHeadsBone) {
   EXPECT_EQ(capDepartures(socket.c.input).regions.at(0).kind, "outward");
 }
 
+TEST(CapDepartures, ASurfaceShortOfADomeTheCtDoesNotPartFromTheSocketIsNoFlattening) {
+  // The dome flattened 2.4 mm as above. With a CT whose bone goes on beyond
+  // the flat (thick slices smear the head's edge into the socket's roof),
+  // the surface there is no edge of the head; with the flattened head's CT,
+  // the widened gap beyond it, it is a flattened dome.
+  Case c;
+  const double plane = kRadius - 0.12 * kRadius;
+  for (Eigen::Index v = 0; v < c.input.vertices.rows(); ++v)
+    if (c.local(v).z() > plane) c.input.vertices(v, 2) = sphere().center.z() + plane;
+  c.choosePoints(plane - 0.5);
+  const imaging::Volume smeared = ctAbout([](const Eigen::Vector3d& x) { return x.norm() < kRadius + 8; });
+  c.input.ct = &smeared;
+  const CapDepartures d = capDepartures(c.input);
+  ASSERT_EQ(d.regions.size(), 1u);
+  EXPECT_EQ(d.regions[0].kind, "bone_beyond");
+  EXPECT_EQ(d.largestFindingMm2(), 0);
+  EXPECT_NEAR(d.largestBoneBeyondMm2(), d.regions[0].area_mm2, 1e-9);
+  const imaging::Volume flattened = ctAbout([plane](const Eigen::Vector3d& x) { return x.norm() < kRadius && x.z() < plane; });
+  c.input.ct = &flattened;
+  const CapDepartures own = capDepartures(c.input);
+  ASSERT_EQ(own.regions.size(), 1u);
+  EXPECT_EQ(own.regions[0].kind, "inward");
+  EXPECT_NEAR(own.largestFindingMm2(), own.regions[0].area_mm2, 1e-9);
+}
+
 // The dome merged with the socket across thick slices: the points a band
 // from 30 degrees below the equator to 24 above, so that the part without
 // points about the pole (66 degrees around it) is larger than the neck's

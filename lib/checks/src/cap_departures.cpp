@@ -149,16 +149,18 @@ void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
 }
 
 constexpr double kProbeMm = 3;
+constexpr double kPastModelMm = 0.5;  // an inward region's outer probe, past the model's surface
 constexpr double kSoftTissueShare = 0.5;  // 3 mm lips on the clinical bench: 0.08-0.46; cuts across the neck: 0.8-1.1
 
 // Per part of the vertices (`part`, -1: none; `parts` of them), what lies
-// beyond it: kSoftTissue where the CT's mean kProbeMm outside its vertices
-// (along `outward_normal`) is below kSoftTissueShare of its mean as far
-// inside; kBone where the bone goes on (a neighbouring bone, or one across
-// a joint gap the CT does not resolve); kUnknown where no probe lies in the CT.
+// beyond it: kSoftTissue where the CT's mean outside its vertices (along
+// `outward_normal`, kProbeMm out or, given, `out_mm` per vertex) is below
+// kSoftTissueShare of its mean kProbeMm inside; kBone where the bone goes
+// on (a neighbouring bone, or one across a joint gap the CT does not
+// resolve); kUnknown where no probe lies in the CT.
 enum Beyond : signed char { kUnknown = -1, kBone = 0, kSoftTissue = 1 };
 std::vector<signed char> whatLiesBeyond(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward_normal, const imaging::Volume& ct,
-                                   const std::vector<int>& part, int parts) {
+                                   const std::vector<int>& part, int parts, const std::vector<double>& out_mm = {}) {
   std::vector<double> inside(static_cast<size_t>(parts), 0), outside(static_cast<size_t>(parts), 0);
   std::vector<int> probed(static_cast<size_t>(parts), 0);
   for (size_t v = 0; v < part.size(); ++v) {
@@ -166,7 +168,7 @@ std::vector<signed char> whatLiesBeyond(const Eigen::MatrixX3d& V, const Eigen::
     const auto p = static_cast<size_t>(part[v]);
     const Eigen::Vector3d x = V.row(static_cast<Eigen::Index>(v)).transpose();
     const Eigen::Vector3d n = outward_normal.row(static_cast<Eigen::Index>(v)).normalized().transpose();
-    const double in = imaging::interpolate(ct, x - kProbeMm * n), out = imaging::interpolate(ct, x + kProbeMm * n);
+    const double in = imaging::interpolate(ct, x - kProbeMm * n), out = imaging::interpolate(ct, x + (out_mm.empty() ? kProbeMm : out_mm[v]) * n);
     if (!std::isfinite(in) || !std::isfinite(out)) continue;
     inside[p] += in;
     outside[p] += out;
@@ -367,12 +369,20 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       region.centre += a * V.row(static_cast<Eigen::Index>(v)).transpose();
       region.depth_mm = std::max(region.depth_mm, std::abs(vertex_distance[v]));
     }
-    // Outwards, with the CT: a region with bone going on beyond it is the
-    // surface run into a neighbouring bone (at the dome, the socket across a
-    // gap the CT does not resolve: a narrowed joint, or slices too thick for
-    // the gap), not the head's own bone standing out.
+    // With the CT, a region with bone going on beyond it is no departure of
+    // the head's bone: outwards, the surface run into a neighbouring bone (at
+    // the dome, the socket across a gap the CT does not resolve: a narrowed
+    // joint, or slices too thick for the gap); inwards, a surface left short
+    // of a dome the CT does not part from the socket (at 2.5 mm slices over
+    // a 2 mm gap the slices there read 430 HU, the head's edge smeared into
+    // the socket's). Inwards the CT is read just past the model's surface:
+    // over a flattened dome that is the widened gap, which a fixed 3 mm can
+    // overshoot into the socket.
+    std::vector<double> out_mm;
+    if (is_inward)
+      for (const double d : vertex_distance) out_mm.push_back(std::abs(d) + kPastModelMm);
     const std::vector<signed char> beyond =
-        is_inward || !in.ct ? std::vector<signed char>() : whatLiesBeyond(V, normal * outward_sign, *in.ct, part, static_cast<int>(regions.size()));
+        !in.ct ? std::vector<signed char>() : whatLiesBeyond(V, normal * outward_sign, *in.ct, part, static_cast<int>(regions.size()), out_mm);
     std::vector<int> kept_as(regions.size(), -1);
     for (size_t k = 0; k < regions.size(); ++k) {
       DepartingRegion& region = regions[k];

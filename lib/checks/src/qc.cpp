@@ -412,15 +412,15 @@ QcReport checkHead(const HeadQcInput& in) {
         ": a flattened or eroded dome, an osteophyte, a surface off the bone there (a neighbouring bone taken in, a "
         "slice too many at coarse slices), or a head no model of the hierarchy follows there; the model describes "
         "the rest (see cap_departures in results.json and the slices)"));
-  // Outward regions with bone going on beyond them are no departure of the
-  // head's bone: the surface ran into a neighbouring bone. At 2.5-3 mm
+  // Regions with bone going on beyond them are no departure of the head's
+  // bone: the surface met a neighbouring bone. At 2.5-3 mm
   // slices over a 2 mm gap the socket's roof joins the dome (395 mm^2 of a
   // correct phantom head); a narrowed joint does the same at any slices.
   if (in.cap_bone_beyond_mm2)
     report.checks.push_back(capRegions(
         "cap_bone_beyond_mm2", *in.cap_bone_beyond_mm2,
-        "the surface runs into bone beyond the head over part of its cap: the largest region departing outwards by " +
-            number(kFindingDepthMm) + " mm or more with bone beyond it (mm^2) is",
+        "the surface meets bone beyond the head over part of its cap: the largest region departing from the model by " +
+            number(kFindingDepthMm) + " mm or more with bone going on beyond it (mm^2) is",
         ": the joint gap is not resolved there (a narrowed joint, or slices too thick for the gap) or a neighbouring "
         "bone was taken into the head's label; the mesh there is not the head's surface (see cap_departures in "
         "results.json and the slices)"));

@@ -175,7 +175,7 @@ std::string departuresSection(const json& results) {
     const std::string kind = text(r, "kind");
     html += "<tr><td>departure_" + std::to_string(++k) + "</td><td>" +
             report::escapeMarkup(kind == "fovea"         ? "fovea (a pit at the medial pole: anatomy)"
-                                 : kind == "bone_beyond" ? "outward, bone beyond (run into a neighbouring bone: no gap seen)"
+                                 : kind == "bone_beyond" ? "bone beyond (no joint gap seen: not the head's edge)"
                                                          : kind) +
             "</td><td>" +
             fixed(numberAt(r, "area_mm2"), 0) + "</td><td>" + fixed(numberAt(r, "depth_mm"), 1) + "</td><td>" +
