@@ -109,11 +109,14 @@ std::string verdictSection(const json& results) {
     open_models += (open_models.empty() ? "" : ", ") + report::escapeMarkup(m.is_string() ? m.get<std::string>() : "");
   if (!open_models.empty())
     html += "<tr><th>not determined by the points (not selectable)</th><td id=\"undetermined\">" + open_models + "</td></tr>\n";
-  if (const json* m = modelNamed(results, selected)) {
+  const json* chosen = modelNamed(results, selected);
+  // An ovoid's or a superovoid's parameters hold its egg terms' scales c0x and c0y.
+  const bool egg = chosen && member(*chosen, "parameters").contains("c0x");
+  if (const json* m = chosen) {
     html += "<tr><th>head centre (mm, LPS)</th><td id=\"head-centre\">" + withInterval(*m, "t1_mm", 2) + ", " +
             withInterval(*m, "t2_mm", 2) + ", " + withInterval(*m, "t3_mm", 2) + "</td></tr>\n";
     const json& parameters = member(*m, "parameters");
-    if (parameters.contains("c0x")) {
+    if (egg) {
       html += "<tr><th>semi-axes through the centre (mm): a&middot;c0x, b&middot;c0y, c</th><td id=\"semi-axes\">" +
               semiAxesWithIntervals(*m) +
               " <span class=\"note\">(an ovoid's a and b share their scale with c0x and c0y; these products are its "
@@ -127,7 +130,6 @@ std::string verdictSection(const json& results) {
     html += "<tr><th>RMS error (mm)</th><td id=\"rms\">" +
             fixed(numberAt(member(*m, "errors"), "rms_mm"), 3) + "</td></tr>\n";
   }
-  const json* chosen = modelNamed(results, selected);
   const json& correlation = member(chosen ? *chosen : results, "residual_correlation");
   std::string note = "&plusmn;: half the 95 % interval (1.96 standard errors), with the residuals' spatial correlation";
   if (correlation.is_object())
@@ -140,7 +142,7 @@ std::string verdictSection(const json& results) {
   note += ". It does not hold a shift of the whole surface shared by every point (an edge found outside a thin "
           "cortex): the radii carry it.";
   // Measured: bench-selection-caps and bench/coverage.py (docs/benchmarks.md).
-  if (selected == "ovoid" || selected == "superovoid")
+  if (egg)
     note += " An egg's centre and semi-axes lie on its equator, beyond a cap about its pole, and trade with its egg "
             "terms along a curved valley a linearised interval does not follow: their intervals hold them less often "
             "(about 90 % of the centres of the phantom heads, 65-80 % on simulated caps of 60-120 degrees).";
