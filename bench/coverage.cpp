@@ -11,6 +11,7 @@
 // semi-axes and against them moved by the shared offset (the points' median
 // signed distance to the true surface, which no interval holds), and the
 // residual correlation. Used by bench/coverage.py.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -19,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "articula/distance/signed_distance.hpp"
+#include "articula/fit/fit_hierarchy.hpp"
 #include "articula/fit/fits_json.hpp"
 #include "articula/fit/uncertainty.hpp"
 #include "articula/geometry/pose.hpp"
@@ -84,7 +86,24 @@ int main(int argc, char** argv) {
           articula::fit::EdgeOffsetField field;
           if (c.contains("spacing_mm"))
             field = articula::fit::edgeOffsetField(vec3(c.at("spacing_mm")), vec3(c.at("slice_axis")));
-          const auto u = articula::fit::parameterUncertainty(shape, points, {}, method, field);
+          auto u = articula::fit::parameterUncertainty(shape, points, {}, method, field);
+          // An egg's intervals take in its other optima, as the fit's do.
+          const bool egg = shape.model == ShapeModel::Ovoid || shape.model == ShapeModel::Superovoid;
+          const auto ellipsoid = std::find_if(shapes.begin(), shapes.end(), [](const ShapeParameters& s) { return s.model == ShapeModel::Ellipsoid; });
+          if (egg && ellipsoid != shapes.end()) {
+            articula::fit::ModelFit f;
+            f.parameters = shape;
+            Eigen::VectorXd r;
+            Eigen::MatrixX3d closest;
+            articula::distance::SignedDistance(shape).evaluate(points, r, closest);
+            f.sse_mm2 = r.squaredNorm();
+            f.uncertainty = u;
+            articula::fit::Options o;
+            o.uncertainty = method;
+            o.edge_offset = field;
+            articula::fit::spanEggOptima(*ellipsoid, points, o, f);
+            u = f.uncertainty;
+          }
           const articula::fit::IntervalErrors z = articula::fit::intervalErrors(shape, u, truth, offset);
           auto list = [](const Eigen::Vector3d& v) { return nlohmann::json{v[0], v[1], v[2]}; };
           const auto& r = u.correlation;

@@ -112,6 +112,7 @@ for m in r["models"]:
     if "c0x" in p and m["model"] == selected:
         assert re.search(r'id="semi-axes">' + r'(?: &plusmn; [0-9.]+)?, '.join("%.2f" % x for x in axes), html), "semi-axes not shown"
         assert "An egg's centre and semi-axes lie on its equator" in html, "the egg's intervals are not qualified"
+        assert "within the likelihood-ratio bound (%d here)" % m["other_optima_spanned"] in html, "the other optima are not counted"
 assert 'class="status %s"' % r["qc"]["status"] in html
 # The selection's evidence: the hierarchy's five steps, each a nested F test
 # with the points' n_eff at the selection's correlation length, and the tests

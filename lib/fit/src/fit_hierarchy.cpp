@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -17,6 +18,7 @@
 #include "articula/distance/signed_distance.hpp"
 #include "articula/geometry/algebraic_fit.hpp"
 #include "articula/fit/levenberg_marquardt.hpp"
+#include "articula/fit/other_optima.hpp"
 #include "articula/fit/parameter_gradient.hpp"
 #include "articula/geometry/pose.hpp"
 #include "articula/geometry/surface.hpp"
@@ -885,7 +887,63 @@ HierarchyFits refineAll(const HierarchyFits& on_sample, const Eigen::MatrixX3d& 
   return h;
 }
 
+// Other labellings' optima are fitted on about this many of the points
+// (every k-th, where there are twice as many or more), with at most this
+// many evaluations each (most take 30-60): their part is the intervals'
+// reach, not the fit.
+constexpr int kOtherOptimaPoints = 1000, kOtherOptimumEvaluations = 150;
+
+// The egg `reported`'s intervals widened over its optima from each labelling
+// of the ellipsoid's axes (other_optima.hpp), compared on the same points.
+void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const Eigen::MatrixX3d& all_points, const Options& o,
+                   ModelFit& reported) {
+  const Eigen::MatrixX3d points = subsample(all_points, kOtherOptimaPoints);
+  const ShapeModel model = reported.parameters.model;
+  double sse = reported.sse_mm2;
+  Eigen::MatrixX3d feet;
+  if (points.rows() != all_points.rows()) exactRms(reported.parameters, points, sse, feet, o.threads);
+  // The bound on all the points' sum of squares, scaled to the subsample's as its rises are.
+  const double bound = likelihoodRatioBoundMm2(reported.parameters, reported.uncertainty, reported.sse_mm2,
+                                               all_points.rows()) *
+                       static_cast<double>(points.rows()) / static_cast<double>(all_points.rows());
+  if (!(bound > 0)) return;
+  Options local = o;
+  local.strategy = Strategy::Local;
+  local.restarts = 0;
+  local.max_evaluations = std::min(o.max_evaluations, kOtherOptimumEvaluations);
+  local.threads = 1;  // the labellings side by side instead
+  std::vector<Start> starts;
+  for (Start start : axisLabellings(ellipsoid)) {
+    if (reported.started_from.rfind(start.label, 0) == 0) continue;  // the reported optimum's own start
+    if (start.feet.rows() == all_points.rows()) start.feet = subsample(start.feet, kOtherOptimaPoints);
+    starts.push_back(start);
+  }
+  // Independent fits, each into its own slot: the same optima for any thread count.
+  std::vector<std::optional<OtherOptimum>> found(starts.size());
+  parallelFor(static_cast<std::ptrdiff_t>(starts.size()), 1, o.threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
+      const Fitted f = fitModel(model, {starts[i]}, bounds, points, local);
+      const bool same = (f.fit.parameters.center - reported.parameters.center).norm() < 1e-6;
+      if (same || !(f.fit.sse_mm2 <= sse + bound)) continue;
+      found[i] = OtherOptimum{f.fit.parameters, f.fit.sse_mm2,
+                              parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty, o.edge_offset, 1)};
+    }
+  });
+  std::vector<OtherOptimum> others;
+  for (auto& f : found)
+    if (f) others.push_back(std::move(*f));
+  spanOtherOptima(reported.parameters, sse, bound, others, reported.uncertainty);
+}
+
 }  // namespace
+
+void spanEggOptima(const ShapeParameters& ellipsoid, const Eigen::MatrixX3d& points, const Options& o, ModelFit& egg) {
+  o.validate();
+  const AlgebraicStarts a = algebraicStarts(points);
+  Fitted parent;
+  parent.fit.parameters = ellipsoid;
+  spanOptimaOfLabellings(parent, makeBounds(egg.parameters.model, a.ellipsoid, a.sphere, o), points, o, egg);
+}
 
 ModelFit fitFrom(const ShapeParameters& start, const Eigen::MatrixX3d& points, const Options& o) {
   o.validate();
@@ -906,6 +964,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
   if (!points.allFinite()) throw InputError("fit: points contain NaN or Inf");
 
   HierarchyFits h;
+  AlgebraicStarts a;
   if (o.sample_points > 0 && points.rows() > o.sample_points) {
     // Fitted on a sample, then finished on samples four times larger up to
     // all the points: each stage starts within a few steps of its optimum,
@@ -915,7 +974,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
     const NestedSamples samples(points.rows(), o.seed);
     Eigen::Index size = o.sample_points;
     const Eigen::MatrixX3d first = samples.take(points, size);
-    const AlgebraicStarts a = algebraicStarts(first);
+    a = algebraicStarts(first);
     h = fitAll(first, a, o, true);
     while (size < points.rows()) {
       size = 8 * size >= points.rows() ? points.rows() : 4 * size;  // no stage of more than half the points
@@ -927,7 +986,8 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
                              std::to_string(points.rows()) + " points, then on all)";
     for (Fitted* f : {&h.sphere, &h.ellipsoid, &h.superellipsoid, &h.ovoid, &h.superovoid}) f->fit.started_from += note;
   } else {
-    h = fitAll(points, algebraicStarts(points), o, false);
+    a = algebraicStarts(points);
+    h = fitAll(points, a, o, false);
   }
 
   Summary summary;
@@ -936,6 +996,9 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
     if (wanted(o, f->fit.parameters.model) && f->fit.evaluations > 0) {
       summary.fits.push_back(f->fit);
       summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty, o.edge_offset, o.threads);
+      const ShapeModel model = f->fit.parameters.model;
+      if ((model == ShapeModel::Ovoid || model == ShapeModel::Superovoid) && o.span_other_optima)
+        spanOptimaOfLabellings(h.ellipsoid, makeBounds(model, a.ellipsoid, a.sphere, o), points, o, summary.fits.back());
     }
   double best_rms = std::numeric_limits<double>::infinity();
   for (const auto& f : summary.fits)

@@ -80,6 +80,8 @@ nlohmann::json modelFitJson(const ModelFit& f) {
             {"n_eff", u.correlation.n_eff},
             {"n_points", u.correlation.n}}},
           {"condition_number", finite(u.condition_number)},
+          {"other_optima_spanned", u.other_optima},
+          {"other_optima_bound_mm2", u.other_optima_bound_mm2},
           {"rms_mm", f.rms_mm},
           {"geometric_objective_mm2", f.sse_mm2},
           {"algebraic_objective", f.algebraic_objective},

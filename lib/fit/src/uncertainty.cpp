@@ -31,19 +31,6 @@ constexpr double kRelativeSingularValue = 1e-10;
 // superellipsoids at 2-3 mm slices).
 constexpr double kLinearPerMm2 = 0.01, kAcrossBaseMm = 0.03, kAcrossPerMm4 = 0.0025, kOddToEven = 1.0;
 
-/// Half-widths beyond which an interval says nothing about the head: a
-/// radius or position known to only +-10 mm, an angle to +-45 degrees, an
-/// exponent to +-1, an ovoid coefficient to +-0.5.
-double uselessHalfWidth(geometry::ParameterKind kind) {
-  switch (kind) {
-    case geometry::ParameterKind::Radius:
-    case geometry::ParameterKind::Translation: return 10.0;
-    case geometry::ParameterKind::Angle: return M_PI / 4;
-    case geometry::ParameterKind::Exponent: return 1.0;
-    default: return 0.5;
-  }
-}
-
 bool isOvoid(ShapeModel m) { return m == ShapeModel::Ovoid || m == ShapeModel::Superovoid; }
 // The meat J^T Sigma J of the sandwich (#k x #k) in the scaled columns of
 // `J`, for the chosen method (SpatialModel's before its level is set).
@@ -90,6 +77,16 @@ Eigen::MatrixXd meat(UncertaintyMethod method, const Eigen::MatrixX3d& points, c
 }
 
 }  // namespace
+
+double uselessHalfWidth(geometry::ParameterKind kind) {
+  switch (kind) {
+    case geometry::ParameterKind::Radius:
+    case geometry::ParameterKind::Translation: return 10.0;
+    case geometry::ParameterKind::Angle: return M_PI / 4;
+    case geometry::ParameterKind::Exponent: return 1.0;
+    default: return 0.5;
+  }
+}
 
 EdgeOffsetField edgeOffsetField(const Eigen::Vector3d& spacing_mm, const Eigen::Vector3d& slice_axis) {
   EdgeOffsetField f;

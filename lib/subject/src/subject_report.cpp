@@ -275,6 +275,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
       entry["semi_axes_se_mm"] = {scaled(sa, ovoid ? shape.cx[0] : 1.0), scaled(sb, ovoid ? shape.cy[0] : 1.0), scaled(sc, 1.0)};
     }
     if (fit_entry.contains("residual_correlation")) entry["residual_correlation"] = fit_entry.at("residual_correlation");
+    if (fit_entry.contains("other_optima_spanned")) entry["other_optima_spanned"] = fit_entry.at("other_optima_spanned");
     if (n > k && sse > 0) {
       entry["aic"] = statistics::aic(sse, n, k);
       entry["bic"] = statistics::bic(sse, n, k);

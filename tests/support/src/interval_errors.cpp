@@ -19,12 +19,21 @@ Eigen::Vector3d semiAxes(const geometry::ShapeParameters& s) {
 IntervalErrors intervalErrors(const geometry::ShapeParameters& fitted, const ParameterUncertainty& uncertainty,
                               const geometry::ShapeParameters& truth, double offset_mm) {
   const auto names = geometry::parameterNames(fitted.model);
-  auto se_of = [&](const std::string& name) {
+  // The interval's half width on the side of the estimate where the error
+  // puts the truth, over 1.96 (the standard error where the interval is
+  // symmetric; an egg's may not be, fit/other_optima.hpp).
+  const Eigen::VectorXd estimate = geometry::toVector(fitted);
+  auto se_of = [&](const std::string& name, double error) -> double {
     const auto at = std::find(names.begin(), names.end(), name);
-    return at == names.end() ? NAN : uncertainty.standard_error[at - names.begin()];
+    if (at == names.end()) return NAN;
+    const auto k = at - names.begin();
+    return (error > 0 ? estimate[k] - uncertainty.ci95_lower[k] : uncertainty.ci95_upper[k] - estimate[k]) / 1.96;
   };
   IntervalErrors e;
-  for (int i = 0; i < 3; ++i) e.centre_z[i] = (fitted.center[i] - truth.center[i]) / se_of("t" + std::to_string(i + 1));
+  for (int i = 0; i < 3; ++i) {
+    const double error = fitted.center[i] - truth.center[i];
+    e.centre_z[i] = error / se_of("t" + std::to_string(i + 1), error);
+  }
   // A sphere has one rotation for any angles: its axes are the truth's.
   const Eigen::Matrix3d Rt = geometry::rotationFromAngles(truth.angles);
   const Eigen::Matrix3d Rf = fitted.model == ShapeModel::Sphere ? Rt : geometry::rotationFromAngles(fitted.angles);
@@ -39,10 +48,13 @@ IntervalErrors intervalErrors(const geometry::ShapeParameters& fitted, const Par
       for (int k = 1; k < 3; ++k)
         if (std::abs(Rf.col(k).dot(Rt.col(i))) > std::abs(Rf.col(j).dot(Rt.col(i)))) j = k;
     }
-    double se = se_of(fitted.model == ShapeModel::Sphere ? "a" : axis_names[j]);
-    if (ovoid && j < 2) se *= j == 0 ? fitted.cx[0] : fitted.cy[0];  // of the semi-axis, c0 held
-    e.semi_axis_z[i] = (semi[j] - true_semi[i]) / se;
-    e.semi_axis_less_offset_z[i] = (semi[j] - true_semi[i] - offset_mm) / se;
+    const auto z = [&](double error) {
+      double se = se_of(fitted.model == ShapeModel::Sphere ? "a" : axis_names[j], error);
+      if (ovoid && j < 2) se *= j == 0 ? fitted.cx[0] : fitted.cy[0];  // of the semi-axis, c0 held
+      return error / se;
+    };
+    e.semi_axis_z[i] = z(semi[j] - true_semi[i]);
+    e.semi_axis_less_offset_z[i] = z(semi[j] - true_semi[i] - offset_mm);
   }
   return e;
 }

@@ -71,6 +71,10 @@ struct Options {
   /// Overrides by parameter name of table 3.2 ("a", "gamma1", "c2x", "t1", ...).
   std::map<std::string, std::pair<double, double>> bounds;
   UncertaintyMethod uncertainty = UncertaintyMethod::SpatialModel;  // of every reported model
+  /// An ovoid's and superovoid's centre and semi-axes intervals take in
+  /// their optima from every labelling of the ellipsoid's axes within the
+  /// likelihood-ratio bound (other_optima.hpp).
+  bool span_other_optima = true;
   /// The edge's offset field the points' voxel grid implies (none: points of
   /// unknown origin; their intervals hold what the residuals show).
   EdgeOffsetField edge_offset;
@@ -111,6 +115,14 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& options = {}
 /// within the bounds fitHierarchy would use: e.g. the reference "started at
 /// the true parameters" of the oracle benchmark.
 ModelFit fitFrom(const geometry::ShapeParameters& start, const Eigen::MatrixX3d& points, const Options& options = {});
+
+/// What fitHierarchy does to an ovoid's or superovoid's intervals
+/// (Options::span_other_optima): `egg`'s centre and semi-axes intervals
+/// widened over its optima on `points` from each labelling of `ellipsoid`'s
+/// axes within the likelihood-ratio bound (other_optima.hpp). For intervals
+/// computed apart from the fit (bench-coverage's methods).
+void spanEggOptima(const geometry::ShapeParameters& ellipsoid, const Eigen::MatrixX3d& points, const Options& options,
+                   ModelFit& egg);
 
 /// The thesis objective eq. 3.1 and the geometric SSE (mm^2) of a shape.
 double algebraicObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);

@@ -76,6 +76,12 @@ struct EdgeOffsetField {
 /// holds no thickness.
 EdgeOffsetField edgeOffsetField(const Eigen::Vector3d& spacing_mm, const Eigen::Vector3d& slice_axis);
 
+/// Half-widths beyond which an interval says nothing about the head: a
+/// radius or position known to only +-10 mm, an angle to +-45 degrees, an
+/// exponent to +-1, an ovoid coefficient to +-0.5 (the parameter is then
+/// listed as not identifiable).
+double uselessHalfWidth(geometry::ParameterKind kind);
+
 struct ParameterUncertainty {
   std::string method;                       // uncertaintyMethodName of the method used
   Eigen::VectorXd standard_error;           // table 3.2 order; infinity where not identifiable or a gauge
@@ -91,6 +97,11 @@ struct ParameterUncertainty {
   std::vector<std::string> gauge;           // held at their fitted values: an ovoid's c0x and c0y
   double condition_number = 0;              // of J^T J with unit-scaled columns, gauge held
   ResidualCorrelation correlation;          // of this fit's residuals
+  /// An egg's other local optima within the likelihood-ratio bound, whose
+  /// centres and semi-axes its intervals take in (other_optima.hpp), and that
+  /// bound on the rise of the sum of squares (mm^2; 0: not searched).
+  int other_optima = 0;
+  double other_optima_bound_mm2 = 0;
 };
 
 /// The uncertainty of `fitted` (a least-squares optimum) on `points` (#P x 3);
