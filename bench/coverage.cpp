@@ -88,21 +88,12 @@ int main(int argc, char** argv) {
             field = articula::fit::edgeOffsetField(vec3(c.at("spacing_mm")), vec3(c.at("slice_axis")));
           auto u = articula::fit::parameterUncertainty(shape, points, {}, method, field);
           // An egg's intervals take in its other optima, as the fit's do.
-          const bool egg = shape.model == ShapeModel::Ovoid || shape.model == ShapeModel::Superovoid;
           const auto ellipsoid = std::find_if(shapes.begin(), shapes.end(), [](const ShapeParameters& s) { return s.model == ShapeModel::Ellipsoid; });
-          if (egg && ellipsoid != shapes.end()) {
-            articula::fit::ModelFit f;
-            f.parameters = shape;
-            Eigen::VectorXd r;
-            Eigen::MatrixX3d closest;
-            articula::distance::SignedDistance(shape).evaluate(points, r, closest);
-            f.sse_mm2 = r.squaredNorm();
-            f.uncertainty = u;
+          if (articula::geometry::contains(shape.model, ShapeModel::Ovoid) && ellipsoid != shapes.end()) {
             articula::fit::Options o;
             o.uncertainty = method;
             o.edge_offset = field;
-            articula::fit::spanEggOptima(*ellipsoid, points, o, f);
-            u = f.uncertainty;
+            articula::fit::spanEggOptima(*ellipsoid, shape, points, o, u);
           }
           const articula::fit::IntervalErrors z = articula::fit::intervalErrors(shape, u, truth, offset);
           auto list = [](const Eigen::Vector3d& v) { return nlohmann::json{v[0], v[1], v[2]}; };

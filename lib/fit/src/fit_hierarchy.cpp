@@ -937,12 +937,19 @@ void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const
 
 }  // namespace
 
-void spanEggOptima(const ShapeParameters& ellipsoid, const Eigen::MatrixX3d& points, const Options& o, ModelFit& egg) {
+void spanEggOptima(const ShapeParameters& ellipsoid, const ShapeParameters& egg, const Eigen::MatrixX3d& points,
+                   const Options& o, ParameterUncertainty& u) {
   o.validate();
   const AlgebraicStarts a = algebraicStarts(points);
   Fitted parent;
   parent.fit.parameters = ellipsoid;
-  spanOptimaOfLabellings(parent, makeBounds(egg.parameters.model, a.ellipsoid, a.sphere, o), points, o, egg);
+  ModelFit reported;
+  reported.parameters = egg;
+  Eigen::MatrixX3d feet;
+  exactRms(egg, points, reported.sse_mm2, feet, o.threads);
+  reported.uncertainty = std::move(u);
+  spanOptimaOfLabellings(parent, makeBounds(egg.model, a.ellipsoid, a.sphere, o), points, o, reported);
+  u = std::move(reported.uncertainty);
 }
 
 ModelFit fitFrom(const ShapeParameters& start, const Eigen::MatrixX3d& points, const Options& o) {
@@ -997,7 +1004,7 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& o) {
       summary.fits.push_back(f->fit);
       summary.fits.back().uncertainty = parameterUncertainty(f->fit.parameters, points, f->feet, o.uncertainty, o.edge_offset, o.threads);
       const ShapeModel model = f->fit.parameters.model;
-      if ((model == ShapeModel::Ovoid || model == ShapeModel::Superovoid) && o.span_other_optima)
+      if (geometry::contains(model, ShapeModel::Ovoid) && o.span_other_optima)
         spanOptimaOfLabellings(h.ellipsoid, makeBounds(model, a.ellipsoid, a.sphere, o), points, o, summary.fits.back());
     }
   double best_rms = std::numeric_limits<double>::infinity();

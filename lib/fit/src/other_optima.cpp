@@ -17,13 +17,8 @@ Eigen::Index indexOf(const std::vector<std::string>& names, const std::string& n
   return at == names.end() ? -1 : at - names.begin();
 }
 
-// What takes radius i of `p` to its semi-axis: an egg's c0x and c0y (its a
-// and b hold the semi-axes only with c0 = 1), else 1.
-double semiAxisFactor(const geometry::ShapeParameters& p, int i) {
-  const bool egg = p.model == geometry::ShapeModel::Ovoid || p.model == geometry::ShapeModel::Superovoid;
-  if (!egg || i == 2) return 1.0;
-  return i == 0 ? p.cx[0] : p.cy[0];
-}
+// What takes radius i of `p` to its semi-axis (an egg's c0x, c0y; else 1).
+double semiAxisFactor(const geometry::ShapeParameters& p, int i) { return geometry::semiAxes(p)[i] / p.radii[i]; }
 
 }  // namespace
 
@@ -69,10 +64,8 @@ void spanOtherOptima(const geometry::ShapeParameters& fitted, double sse_mm2, do
     if (!(other.sse_mm2 <= sse_mm2 + bound_mm2) || other.parameters.model != fitted.model ||
         v.standard_error.size() != u.standard_error.size())
       continue;
-    bool distinct = false;
     for (int i = 0; i < 3; ++i) {
       const Eigen::Index t = indexOf(names, "t" + std::to_string(i + 1));
-      distinct |= std::abs(other.parameters.center[i] - fitted.center[i]) > 1e-6;
       takeIn(t, other.parameters.center[i], v.standard_error[t]);
     }
     if (radius[1] >= 0 && radius[2] >= 0) {
@@ -85,7 +78,7 @@ void spanOtherOptima(const geometry::ShapeParameters& fitted, double sse_mm2, do
         takeIn(radius[i], other.parameters.radii[k] * theirs / own, v.standard_error[radius[k]] * theirs / own);
       }
     }
-    spanned += distinct;
+    ++spanned;
   }
   for (size_t j = 0; j < names.size(); ++j) {
     if (!widened[j]) continue;

@@ -118,6 +118,12 @@ ShapeParameters fromVector(ShapeModel m, const Eigen::VectorXd& x) {
   return p;
 }
 
+Eigen::Vector3d semiAxes(const ShapeParameters& p) {
+  if (p.model == ShapeModel::Sphere) return Eigen::Vector3d::Constant(p.radii[0]);
+  const bool egg = contains(p.model, ShapeModel::Ovoid);
+  return {p.radii[0] * (egg ? p.cx[0] : 1.0), p.radii[1] * (egg ? p.cy[0] : 1.0), p.radii[2]};
+}
+
 bool contains(ShapeModel general, ShapeModel special) {
   if (general == special || special == ShapeModel::Sphere) return true;
   switch (general) {

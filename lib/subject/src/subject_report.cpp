@@ -63,14 +63,6 @@ json stepJson(const statistics::NestedStep& s) {
           {"richer_needed", s.richer_needed}};
 }
 
-// The half widths through the centre along the local axes: an ovoid's a
-// and b are scaled by c0x and c0y, and only the products are its shape.
-Eigen::Vector3d semiAxes(const geometry::ShapeParameters& shape) {
-  if (shape.model == geometry::ShapeModel::Sphere) return Eigen::Vector3d::Constant(shape.radii[0]);
-  const bool ovoid = shape.model == geometry::ShapeModel::Ovoid || shape.model == geometry::ShapeModel::Superovoid;
-  return {shape.radii[0] * (ovoid ? shape.cx[0] : 1.0), shape.radii[1] * (ovoid ? shape.cy[0] : 1.0), shape.radii[2]};
-}
-
 json readStageJson(const fs::path& path) {
   if (!fs::exists(path))
     throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
@@ -247,7 +239,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
     const int n = errors.value("n_points", 0);
     const double sse = errors.value("sse_mm2", 0.0);
     json entry = {{"model", name}, {"n_parameters", k}, {"parameters", parameters}, {"errors", errors}};
-    const Eigen::Vector3d semi = semiAxes(shape);
+    const Eigen::Vector3d semi = geometry::semiAxes(shape);
     entry["semi_axes_mm"] = {semi[0], semi[1], semi[2]};
     // Standard errors in the parameters' units (angles in degrees); null:
     // not identifiable from these points (fits.json, fit/uncertainty.hpp).
@@ -357,7 +349,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
   std::vector<LandmarkLine> axes;
   const char* axis_names[3] = {"axis_a", "axis_b", "axis_c"};
   for (int i = 0; i < 3; ++i)
-    axes.push_back({axis_names[i], c - semiAxes(selected_shape)[i] * R.col(i), c + semiAxes(selected_shape)[i] * R.col(i)});
+    axes.push_back({axis_names[i], c - geometry::semiAxes(selected_shape)[i] * R.col(i), c + geometry::semiAxes(selected_shape)[i] * R.col(i)});
 
   json steps_json = json::array(), path_json = json::array();
   for (const statistics::NestedStep& st : selection.steps) steps_json.push_back(stepJson(st));

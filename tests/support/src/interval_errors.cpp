@@ -10,12 +10,6 @@ namespace articula::fit {
 
 using geometry::ShapeModel;
 
-Eigen::Vector3d semiAxes(const geometry::ShapeParameters& s) {
-  const bool ovoid = s.model == ShapeModel::Ovoid || s.model == ShapeModel::Superovoid;
-  if (s.model == ShapeModel::Sphere) return Eigen::Vector3d::Constant(s.radii[0]);
-  return {s.radii[0] * (ovoid ? s.cx[0] : 1.0), s.radii[1] * (ovoid ? s.cy[0] : 1.0), s.radii[2]};
-}
-
 IntervalErrors intervalErrors(const geometry::ShapeParameters& fitted, const ParameterUncertainty& uncertainty,
                               const geometry::ShapeParameters& truth, double offset_mm) {
   const auto names = geometry::parameterNames(fitted.model);
@@ -37,7 +31,7 @@ IntervalErrors intervalErrors(const geometry::ShapeParameters& fitted, const Par
   // A sphere has one rotation for any angles: its axes are the truth's.
   const Eigen::Matrix3d Rt = geometry::rotationFromAngles(truth.angles);
   const Eigen::Matrix3d Rf = fitted.model == ShapeModel::Sphere ? Rt : geometry::rotationFromAngles(fitted.angles);
-  const Eigen::Vector3d true_semi = semiAxes(truth), semi = semiAxes(fitted);
+  const Eigen::Vector3d true_semi = geometry::semiAxes(truth), semi = geometry::semiAxes(fitted);
   const bool ovoid = fitted.model == ShapeModel::Ovoid || fitted.model == ShapeModel::Superovoid;
   const char* axis_names[3] = {"a", "b", "c"};
   for (int i = 0; i < 3; ++i) {

@@ -117,12 +117,13 @@ Summary fitHierarchy(const Eigen::MatrixX3d& points, const Options& options = {}
 ModelFit fitFrom(const geometry::ShapeParameters& start, const Eigen::MatrixX3d& points, const Options& options = {});
 
 /// What fitHierarchy does to an ovoid's or superovoid's intervals
-/// (Options::span_other_optima): `egg`'s centre and semi-axes intervals
-/// widened over its optima on `points` from each labelling of `ellipsoid`'s
-/// axes within the likelihood-ratio bound (other_optima.hpp). For intervals
-/// computed apart from the fit (bench-coverage's methods).
-void spanEggOptima(const geometry::ShapeParameters& ellipsoid, const Eigen::MatrixX3d& points, const Options& options,
-                   ModelFit& egg);
+/// (Options::span_other_optima): `u`, the uncertainty of `egg` (an optimum on
+/// `points`), with its centre and semi-axes intervals widened over the egg's
+/// optima from each labelling of `ellipsoid`'s axes within the
+/// likelihood-ratio bound (other_optima.hpp). For intervals computed apart
+/// from the fit (bench-coverage's methods).
+void spanEggOptima(const geometry::ShapeParameters& ellipsoid, const geometry::ShapeParameters& egg,
+                   const Eigen::MatrixX3d& points, const Options& options, ParameterUncertainty& u);
 
 /// The thesis objective eq. 3.1 and the geometric SSE (mm^2) of a shape.
 double algebraicObjective(const geometry::ShapeParameters& shape, const Eigen::MatrixX3d& points);

@@ -25,7 +25,8 @@
 
 namespace articula::fit {
 
-/// Another local optimum of the same model on the same points.
+/// Another local optimum of the same model on the same points (not the
+/// reported one itself).
 struct OtherOptimum {
   geometry::ShapeParameters parameters;
   double sse_mm2 = 0;

@@ -66,6 +66,10 @@ ShapeParameters fromVector(ShapeModel model, const Eigen::VectorXd& lambda);
 ShapeParameters promote(const ShapeParameters& p, ShapeModel target);
 /// True if `general` contains `special` in the hierarchy (a model contains itself).
 bool contains(ShapeModel general, ShapeModel special);
+/// The half widths through the local origin along the local axes: an
+/// ovoid's a c0x, b c0y and c (its a and b share their scale with c0x and
+/// c0y; only the products are its shape); a sphere's radius three times.
+Eigen::Vector3d semiAxes(const ShapeParameters& p);
 
 /// Throws InvalidParameter naming the first parameter out of range:
 /// radii finite and > 0; exponents finite and >= 2; ovoid coefficients within

@@ -9,10 +9,6 @@
 
 namespace articula::fit {
 
-/// The half widths through the local origin along the local axes (an
-/// ovoid's a c0x, b c0y, c; a sphere's radius three times).
-Eigen::Vector3d semiAxes(const geometry::ShapeParameters& shape);
-
 struct IntervalErrors {
   Eigen::Vector3d centre_z;     // (fitted - true) / standard error, per LPS coordinate
   Eigen::Vector3d semi_axis_z;  // per true axis: the fitted semi-axis along it, less the true, over its standard error
