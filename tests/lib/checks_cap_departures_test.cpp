@@ -2,7 +2,8 @@
 // reshaped where the answer is known in closed form: a dome flattened by a
 // plane, an outward bump on the cap's rim, a pit at the medial pole, a neck
 // rising beyond the rim with and without a lip at the junction, a raised
-// dome with and without the socket's bone beyond it.
+// dome with and without the socket's bone beyond it, a surface running on
+// past half a radius.
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -297,6 +298,31 @@ TEST(CapDepartures, ARegionWithBoneBeyondIsTheSurfaceRunIntoItNotTheHeadsBone) {
   // Without the CT nothing tells them apart.
   socket.c.input.ct = nullptr;
   EXPECT_EQ(capDepartures(socket.c.input).regions.at(0).kind, "outward");
+}
+
+// A surface that runs on past half a radius beyond the head (the socket's
+// roof and the pelvis merged into the label) is another bone, with or
+// without the CT; a raised dome that stays within it departs as before.
+TEST(CapDepartures, ASurfaceRunningOnPastHalfARadiusIsAnotherBone) {
+  Case merged;
+  merged.choosePoints(kRadius);
+  merged.bump(Eigen::Vector3d::UnitZ(), 8, 14);  // the apex 1.7 radii out
+  const CapDepartures d = capDepartures(merged.input);
+  ASSERT_EQ(d.regions.size(), 1u);
+  EXPECT_EQ(d.regions[0].kind, "bone_beyond");
+  EXPECT_EQ(d.regions[0].where, "superior");
+  EXPECT_GT(d.regions[0].depth_mm, 0.45 * kRadius);
+  EXPECT_EQ(d.largestFindingMm2(), 0);
+  EXPECT_NEAR(d.largestBoneBeyondMm2(), d.regions[0].area_mm2, 1e-9);
+
+  Case raised;
+  raised.choosePoints(kRadius);
+  raised.bump(Eigen::Vector3d::UnitZ(), 8, 8);  // 1.4 radii out
+  const CapDepartures own = capDepartures(raised.input);
+  ASSERT_EQ(own.regions.size(), 1u);
+  EXPECT_EQ(own.regions[0].kind, "outward");
+  EXPECT_NEAR(own.regions[0].depth_mm, 8, 0.05);
+  EXPECT_NEAR(own.largestFindingMm2(), own.regions[0].area_mm2, 1e-9);
 }
 
 TEST(CapDepartures, ASurfaceShortOfADomeTheCtDoesNotPartFromTheSocketIsNoFlattening) {

@@ -21,6 +21,7 @@ constexpr int kCapDirections = 3000;     // about 3.7 degrees apart
 constexpr double kChannelDeg = 8;        // half the narrowest channel that joins a hole to the part beyond
 constexpr double kNeckPartShare = 0.25;  // of the largest part without points: a hip's part beyond is the one of these towards its neck
 constexpr double kThresholdFloorMm = 0.75;
+constexpr double kZoneInner = 0.5, kZoneOuter = 1.5;  // the vertices measured lie within these model radii of the centre
 constexpr double kFoveaMaxAngleDeg = 45;  // from the medial direction
 constexpr double kFoveaMaxAreaMm2 = 250, kFoveaMaxDepthMm = 5;
 
@@ -316,12 +317,13 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
   vertexAreasAndNormals(V, in.triangles, area, normal);
   const double radius = in.model.radii.maxCoeff();
   std::vector<int> zone;
-  std::vector<char> zone_place;
+  std::vector<char> zone_place, past_zone(static_cast<size_t>(V.rows()), 0);
   Eigen::Index facing_out = 0, facing_in = 0;
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
     const Eigen::Vector3d d = V.row(v).transpose() - c;
     const double reach = d.norm();
-    if (reach < 0.5 * radius || reach > 1.5 * radius) continue;
+    past_zone[static_cast<size_t>(v)] = reach > kZoneOuter * radius;
+    if (reach < kZoneInner * radius || reach > kZoneOuter * radius) continue;
     const double facing = normal.row(v).dot(d);
     facing_out += facing > 0;
     facing_in += facing < 0;
@@ -355,12 +357,13 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
     const int first_lip = is_inward || !in.ct || !in.seek_junction_lip ? std::numeric_limits<int>::max()
                                               : splitLipsFromNeck(V, normal * outward_sign, c, in.points, beyond_rim, in.triangles, *in.ct, vertex_distance, part);
     std::vector<DepartingRegion> regions;
-    std::vector<char> reaches_beyond;
+    std::vector<char> reaches_beyond, runs_out;
     for (size_t v = 0; v < part.size(); ++v) {
       if (part[v] < 0) continue;
       if (static_cast<size_t>(part[v]) >= regions.size()) {
         regions.resize(static_cast<size_t>(part[v]) + 1);
         reaches_beyond.resize(regions.size(), 0);
+        runs_out.resize(regions.size(), 0);
       }
       reaches_beyond[static_cast<size_t>(part[v])] |= beyond_rim[v];
       DepartingRegion& region = regions[static_cast<size_t>(part[v])];
@@ -378,6 +381,18 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
     // the socket's). Inwards the CT is read just past the model's surface:
     // over a flattened dome that is the widened gap, which a fixed 3 mm can
     // overshoot into the socket.
+    // Outwards, a region whose surface runs on past the zone's outer reach
+    // (half a radius out) leaves the head: no osteophyte stands that high;
+    // it is another bone the label took in (the socket's roof merged
+    // across a gap the slices do not resolve, the pelvis beyond it).
+    if (!is_inward)
+      for (Eigen::Index t = 0; t < in.triangles.rows(); ++t) {
+        bool past = false;
+        for (int k = 0; k < 3; ++k) past = past || past_zone[static_cast<size_t>(in.triangles(t, k))];
+        if (!past) continue;
+        for (int k = 0; k < 3; ++k)
+          if (const int p = part[static_cast<size_t>(in.triangles(t, k))]; p >= 0) runs_out[static_cast<size_t>(p)] = 1;
+      }
     std::vector<double> out_mm;
     if (is_inward)
       for (const double d : vertex_distance) out_mm.push_back(std::abs(d) + kPastModelMm);
@@ -395,7 +410,7 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       region.from_cap_axis_deg = degrees(region.direction, out.cap_axis);
       region.where = anatomicalWords(region.direction, in.medial);
       region.kind = is_inward ? "inward" : "outward";
-      if (!beyond.empty() && beyond[k] == kBone) region.kind = "bone_beyond";
+      if ((!beyond.empty() && beyond[k] == kBone) || runs_out[k]) region.kind = "bone_beyond";
       // A hip's fovea capitis: a small pit at the head's medial pole, where
       // the ligament of the head attaches; every femoral head has one.
       if (is_inward && in.medial && degrees(region.direction, *in.medial) <= kFoveaMaxAngleDeg &&

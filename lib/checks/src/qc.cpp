@@ -420,7 +420,7 @@ QcReport checkHead(const HeadQcInput& in) {
     report.checks.push_back(capRegions(
         "cap_bone_beyond_mm2", *in.cap_bone_beyond_mm2,
         "the surface meets bone beyond the head over part of its cap: the largest region departing from the model by " +
-            number(kFindingDepthMm) + " mm or more with bone going on beyond it (mm^2) is",
+            number(kFindingDepthMm) + " mm or more with bone going on beyond it, or running on past half a radius (mm^2), is",
         ": the joint gap is not resolved there (a narrowed joint, or slices too thick for the gap) or a neighbouring "
         "bone was taken into the head's label; the mesh there is not the head's surface (see cap_departures in "
         "results.json and the slices)"));

@@ -76,7 +76,7 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
                           const std::optional<checks::CapDepartures>& departures) {
   checks::HeadQcInput in;
   if (departures) in.cap_departure_mm2 = departures->largestFindingMm2();
-  if (departures && ct) in.cap_bone_beyond_mm2 = departures->largestBoneBeyondMm2();
+  if (departures) in.cap_bone_beyond_mm2 = departures->largestBoneBeyondMm2();
   in.points = cloud.positions;
   in.normals = cloud.normals;
   if (ct && in.normals.rows() == in.points.rows()) {

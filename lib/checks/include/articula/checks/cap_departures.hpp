@@ -22,8 +22,9 @@ namespace articula::checks {
 struct DepartingRegion {
   // "inward", "outward", "fovea" (a hip's inward pit at the medial pole:
   // normal anatomy) or "bone_beyond" (outward, with the CT's bone going on
-  // beyond it: the surface run into a neighbouring bone, such as the socket
-  // across a joint gap the CT does not resolve).
+  // beyond it or the surface running on past half a radius out: the surface
+  // run into a neighbouring bone, such as the socket across a joint gap the
+  // CT does not resolve).
   std::string kind;
   double area_mm2 = 0;     // the mesh area of its vertices
   double depth_mm = 0;     // its largest distance from the model (positive, in either direction)
@@ -79,7 +80,8 @@ struct CapDepartureInput {
 /// max(0.75 mm, 3 x the points' robust residual SD, 0.3 voxel). Outward
 /// regions that run on beyond the rim (the neck) are left out, but for a
 /// lip on them at a hip's junction, which is sought with the CT. With the
-/// CT, an outward region with bone beyond it is of kind "bone_beyond".
+/// CT, an outward region with bone beyond it is of kind "bone_beyond"; so,
+/// with or without it, is one whose surface runs on past 1.5 model radii.
 CapDepartures capDepartures(const CapDepartureInput& input);
 
 }  // namespace articula::checks

@@ -51,7 +51,7 @@ struct HeadQcInput {
   std::optional<double> head_outside_volume_share;  // headOutsideVolumeShare, where a CT was given
   std::optional<double> metal_near_head_mm3;     // metalNearHead, where a CT was given
   std::optional<double> cap_departure_mm2;       // CapDepartures::largestFindingMm2, where the bone's mesh was given
-  std::optional<double> cap_bone_beyond_mm2;     // CapDepartures::largestBoneBeyondMm2, where the mesh and the CT were given
+  std::optional<double> cap_bone_beyond_mm2;     // CapDepartures::largestBoneBeyondMm2, where the mesh was given
   std::vector<std::string> stage_warnings;       // what the stages warned of (the segmentation's summary: reading, search)
   std::optional<bool> surface_on_ct_edges;       // the mesh stage moved the surface onto the CT's edges (else the label's staircase)
   std::string joint;                             // "hip" or "shoulder", for the head's distance from the body's middle
