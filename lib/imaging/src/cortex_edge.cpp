@@ -566,7 +566,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
   // Each search's grid, which only finds the basins, is summed over a few
   // hundred of the lines (thinned, leastBasin); the refinement that sets
   // the width, over every line. (Grids over every line took half of the
-  // mesh stage; the widths came out within 0.01 mm of theirs.)
+  // mesh stage; on 32 phantom heads the surfaces moved 0.003 mm, median.)
   const auto total = [&](const std::vector<size_t>& subset, PointSpread::Kind kind, double in_plane, double across,
                          const std::vector<CortexTissue>* held = nullptr) {
     PointSpread trial;
