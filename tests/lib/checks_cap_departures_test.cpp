@@ -179,7 +179,8 @@ TEST(CapDepartures, ANeckRisingOutOfTheHeadBeyondTheRimIsNoFinding) {
 
 // A CT of 1 mm voxels over the sphere and 15 mm about it: 500 HU where
 // `bone` holds (of the position relative to the sphere's centre), 0 elsewhere.
-imaging::Volume ctAbout(const std::function<bool(const Eigen::Vector3d&)>& bone) {
+// A CT of `hu` at each voxel (a function of the position from the centre).
+imaging::Volume ctOf(const std::function<float(const Eigen::Vector3d&)>& hu) {
   imaging::Volume ct;
   ct.geometry.spacing = Eigen::Vector3d::Constant(1.0);
   ct.geometry.size = Eigen::Vector3i::Constant(70);
@@ -188,8 +189,13 @@ imaging::Volume ctAbout(const std::function<bool(const Eigen::Vector3d&)>& bone)
   for (int k = 0; k < 70; ++k)
     for (int j = 0; j < 70; ++j)
       for (int i = 0; i < 70; ++i)
-        ct.at(i, j, k) = bone(ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center) ? 500.0f : 0.0f;
+        ct.at(i, j, k) = hu(ct.geometry.toPhysical(Eigen::Vector3d(i, j, k)) - sphere().center);
   return ct;
+}
+
+// 500 HU where `bone`, 0 elsewhere.
+imaging::Volume ctAbout(const std::function<bool(const Eigen::Vector3d&)>& bone) {
+  return ctOf([&bone](const Eigen::Vector3d& x) { return bone(x) ? 500.0f : 0.0f; });
 }
 
 // A neck rising out of the head from 127 degrees (1 mm every 5 degrees, as
@@ -265,13 +271,13 @@ TEST(CapDepartures, ALipAtTheJunctionIsToldFromTheNeckItJoins) {
 struct RaisedDome {
   Case c;
   imaging::Volume ct;
-  explicit RaisedDome(bool socket) {
+  explicit RaisedDome(bool socket, float socket_hu = 500) {
     c.choosePoints(kRadius);
     c.bump(Eigen::Vector3d::UnitZ(), 6, 3);
-    ct = ctAbout([socket](const Eigen::Vector3d& x) {
+    ct = ctOf([socket, socket_hu](const Eigen::Vector3d& x) {
       const double s = (x.normalized() * kRadius - kRadius * Eigen::Vector3d::UnitZ()).norm();
-      const bool inside = x.norm() < kRadius + (s < 6 ? 3 * (1 - s * s / 36) : 0);
-      return inside || (socket && x.norm() > kRadius + 2 && x.norm() < kRadius + 10);
+      if (x.norm() < kRadius + (s < 6 ? 3 * (1 - s * s / 36) : 0)) return 500.0f;
+      return socket && x.norm() > kRadius + 2 && x.norm() < kRadius + 10 ? socket_hu : 0.0f;
     });
     c.input.ct = &ct;
   }
@@ -286,6 +292,12 @@ TEST(CapDepartures, ARegionWithBoneBeyondIsTheSurfaceRunIntoItNotTheHeadsBone) {
   EXPECT_EQ(d.regions[0].where, "superior");
   EXPECT_EQ(d.largestFindingMm2(), 0);
   EXPECT_NEAR(d.largestBoneBeyondMm2(), d.regions[0].area_mm2, 1e-9);
+
+  // A socket of cancellous bone, 200 HU beside the head's 500 (under half
+  // of it), is bone all the same.
+  RaisedDome dim(true, 200);
+  ASSERT_EQ(capDepartures(dim.c.input).regions.size(), 1u);
+  EXPECT_EQ(capDepartures(dim.c.input).regions[0].kind, "bone_beyond");
 
   // Soft tissue beyond: the head's own bone stands out.
   RaisedDome bare(false);

@@ -152,16 +152,19 @@ void vertexAreasAndNormals(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
 constexpr double kProbeMm = 3;
 constexpr double kPastModelMm = 0.5;  // an inward region's outer probe, past the model's surface
 constexpr double kSoftTissueShare = 0.5;  // 3 mm lips on the clinical bench: 0.08-0.46; cuts across the neck: 0.8-1.1
+constexpr double kBoneBeyondHu = 150;     // soft tissue reads under 100 HU; a socket's cancellous bone 150-400
 
 // Per part of the vertices (`part`, -1: none; `parts` of them), what lies
 // beyond it: kSoftTissue where the CT's mean outside its vertices (along
 // `outward_normal`, kProbeMm out or, given, `out_mm` per vertex) is below
-// kSoftTissueShare of its mean kProbeMm inside; kBone where the bone goes
-// on (a neighbouring bone, or one across a joint gap the CT does not
-// resolve); kUnknown where no probe lies in the CT.
+// kSoftTissueShare of its mean kProbeMm inside and below `bone_hu`;
+// kBone where the bone goes on (a neighbouring bone, or one across a joint
+// gap the CT does not resolve: a socket's cancellous bone can read under
+// half the head's cortex beside it); kUnknown where no probe lies in the CT.
 enum Beyond : signed char { kUnknown = -1, kBone = 0, kSoftTissue = 1 };
 std::vector<signed char> whatLiesBeyond(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward_normal, const imaging::Volume& ct,
-                                   const std::vector<int>& part, int parts, const std::vector<double>& out_mm = {}) {
+                                   const std::vector<int>& part, int parts, double bone_hu,
+                                   const std::vector<double>& out_mm = {}) {
   std::vector<double> inside(static_cast<size_t>(parts), 0), outside(static_cast<size_t>(parts), 0);
   std::vector<int> probed(static_cast<size_t>(parts), 0);
   for (size_t v = 0; v < part.size(); ++v) {
@@ -177,7 +180,8 @@ std::vector<signed char> whatLiesBeyond(const Eigen::MatrixX3d& V, const Eigen::
   }
   std::vector<signed char> beyond(static_cast<size_t>(parts), kUnknown);
   for (size_t p = 0; p < beyond.size(); ++p)
-    if (probed[p] > 0) beyond[p] = outside[p] < kSoftTissueShare * inside[p] ? kSoftTissue : kBone;
+    if (probed[p] > 0)
+      beyond[p] = outside[p] < kSoftTissueShare * inside[p] && outside[p] < bone_hu * probed[p] ? kSoftTissue : kBone;
   return beyond;
 }
 
@@ -227,7 +231,10 @@ int splitLipsFromNeck(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& outward
   // Where the head's label was cut across the neck, the bone goes on
   // beyond the mesh; beyond a lip lies soft tissue. The distance to the
   // articular points, the costly test, only for the parts that pass these.
-  const std::vector<signed char> beyond = whatLiesBeyond(V, outward_normal, ct, lip, lips);
+  // The ratio alone: across 2.5-3 mm slices the socket's rim blurs to over
+  // kBoneBeyondHu 3 mm beyond two of six 3 mm lips on the clinical bench.
+  const std::vector<signed char> beyond =
+      whatLiesBeyond(V, outward_normal, ct, lip, lips, std::numeric_limits<double>::infinity());
   std::vector<char> is_lip(static_cast<size_t>(lips), 0);
   for (size_t p = 0; p < is_lip.size(); ++p)
     is_lip[p] = beyond[p] == kSoftTissue && percentile(height[p], 0.5) >= kLipMinHeightMm;
@@ -397,7 +404,7 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
     if (is_inward)
       for (const double d : vertex_distance) out_mm.push_back(std::abs(d) + kPastModelMm);
     const std::vector<signed char> beyond =
-        !in.ct ? std::vector<signed char>() : whatLiesBeyond(V, normal * outward_sign, *in.ct, part, static_cast<int>(regions.size()), out_mm);
+        !in.ct ? std::vector<signed char>() : whatLiesBeyond(V, normal * outward_sign, *in.ct, part, static_cast<int>(regions.size()), kBoneBeyondHu, out_mm);
     std::vector<int> kept_as(regions.size(), -1);
     for (size_t k = 0; k < regions.size(); ++k) {
       DepartingRegion& region = regions[k];
@@ -410,7 +417,9 @@ CapDepartures capDepartures(const CapDepartureInput& in) {
       region.from_cap_axis_deg = degrees(region.direction, out.cap_axis);
       region.where = anatomicalWords(region.direction, in.medial);
       region.kind = is_inward ? "inward" : "outward";
-      if ((!beyond.empty() && beyond[k] == kBone) || runs_out[k]) region.kind = "bone_beyond";
+      // A lip has soft tissue beyond it by the ratio (splitLipsFromNeck).
+      const bool lip = static_cast<int>(k) >= first_lip;
+      if ((!beyond.empty() && beyond[k] == kBone && !lip) || runs_out[k]) region.kind = "bone_beyond";
       // A hip's fovea capitis: a small pit at the head's medial pole, where
       // the ligament of the head attaches; every femoral head has one.
       if (is_inward && in.medial && degrees(region.direction, *in.medial) <= kFoveaMaxAngleDeg &&
