@@ -3,9 +3,11 @@
 # are refused by name before any work (exit 2) unless --force, a folder of
 # the user's files is refused even with --force, and the clean-up of an
 # interrupted run touches only articula's own temporaries. Small CTs, their
-# edges on the steepest fall (the blurred-cortex model would quadruple the
-# runs' time; the test is of files).
+# edges on the steepest fall and the sphere alone fitted (the blurred-cortex
+# model and the other four fits would take most of the runs' time; the test
+# is of files).
 source "$(dirname "$0")/common.bash"
+fast=(--edge-model steepest --models sphere)
 
 # sums FOLDER: a listing of every file under FOLDER with its checksum.
 sums() { (cd "$1" && find . -type f -exec sha256sum {} + | sort); }
@@ -42,11 +44,11 @@ grep -q "is a file: expected a folder" "$tmp/err" || fail "phantom -o FILE: $(ca
 u="$tmp/u"
 mkdir -p "$u"
 echo "<p>the user's page</p>" > "$u/report.html"
-expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$u" -q --edge-model steepest
+expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$u" -q "${fast[@]}"
 grep -q "refusing to overwrite .*report.html, which articula run did not write" "$tmp/err" ||
   fail "run: report.html not named: $(cat "$tmp/err")"
 [ "$(ls -A "$u")" = "report.html" ] || fail "run wrote before refusing: $(ls -A "$u")"
-expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/a-file" -q --edge-model steepest
+expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/a-file" -q "${fast[@]}"
 grep -q "is a file: expected a folder" "$tmp/err" || fail "run -o FILE: $(cat "$tmp/err")"
 
 # run's clean-up: articula's own temporary of a writer that has exited is
@@ -61,20 +63,20 @@ echo "draft" > "$r/.tmp-4000000-draft.txt"
 echo "draft" > "$r/.articula-tmp-99999999999999999999-x"
 echo "draft" > "$r/drafts/.articula-tmp-$dead-draft.txt"
 echo "half" > "$r/.articula-tmp-$dead-points.ply"
-expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$r" -q --edge-model steepest
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$r" -q "${fast[@]}"
 [ ! -e "$r/.articula-tmp-$dead-points.ply" ] || fail "run left its own stale temporary"
 for kept in .tmp-4000000-draft.txt .articula-tmp-99999999999999999999-x "drafts/.articula-tmp-$dead-draft.txt"; do
   [ -e "$r/$kept" ] || fail "run's clean-up deleted the user's $kept"
 done
 # A second run replaces what the first wrote without --force.
 touch "$p/phantom.nii.gz"
-expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$r" -q --edge-model steepest
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$r" -q "${fast[@]}"
 # batch: a study.csv of the user's in the study folder is refused by name
 # before any subject runs; a batch's own tables are replaced by its rerun.
 b="$tmp/b"
 mkdir -p "$b"
 echo "subject,mine" > "$b/study.csv"
-printf 'subject,input,joint,side,edge_model\ns1,%s,hip,right,steepest\n' "$p/phantom.nii.gz" > "$tmp/manifest.csv"
+printf 'subject,input,joint,side,edge_model,models\ns1,%s,hip,right,steepest,sphere\n' "$p/phantom.nii.gz" > "$tmp/manifest.csv"
 expect_rc 2 "$bin/articula" batch "$tmp/manifest.csv" -o "$b" -q
 grep -q "refusing to overwrite .*study.csv, which articula batch did not write" "$tmp/err" ||
   fail "batch: study.csv not named: $(cat "$tmp/err")"
@@ -97,13 +99,13 @@ c="$tmp/c"
 mkdir -p "$c/errors"
 echo '{"mine": true}' > "$c/label.nii.gz.json"
 echo "mine" > "$c/errors/points_sphere.vtp"
-expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q --edge-model steepest
+expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q "${fast[@]}"
 grep -q "refusing to overwrite .*label.nii.gz.json, .*errors/points_sphere.vtp, which articula run did not write" "$tmp/err" ||
   fail "run: the user's sidecars not named: $(cat "$tmp/err")"
 [ "$(cat "$c/label.nii.gz.json")" = '{"mine": true}' ] && [ ! -e "$c/.articula" ] || fail "run wrote before refusing"
-expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q --edge-model steepest --force
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q "${fast[@]}" --force
 grep -q '"provenance"' "$c/label.nii.gz.json" || fail "run --force did not replace the sidecar"
-expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q --edge-model steepest
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$c" -q "${fast[@]}"
 
 # The stage programs check what they write beside their output the same way.
 echo '{"mine": true}' > "$tmp/label.nii.gz.json"
@@ -133,21 +135,21 @@ grep -q '"command"' "$tmp/bs/subjects/s1/status.json" || fail "batch --force did
 # first completes. The first is paused once it holds the lock, so that it
 # cannot finish before the second starts.
 l="$tmp/l"
-"$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q --edge-model steepest & first=$!
+"$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q "${fast[@]}" & first=$!
 for _ in $(seq 500); do [ -s "$l/.articula/lock" ] && break; sleep 0.02; done
 kill -STOP "$first"
-expect_rc 1 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q --edge-model steepest
+expect_rc 1 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q "${fast[@]}"
 kill -CONT "$first"
 grep -q "output folder '$l' is in use by articula run (pid $first)" "$tmp/err" || fail "second run: $(cat "$tmp/err")"
 wait "$first" || fail "the first run failed beside the refused second"
 [ -e "$l/results.json" ] || fail "the first run did not finish"
 # A killed run leaves no lock: the next run proceeds (and resumes).
 rm -rf "$l"
-"$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q --edge-model steepest & killed=$!
+"$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q "${fast[@]}" & killed=$!
 for _ in $(seq 500); do [ -s "$l/.articula/lock" ] && break; sleep 0.02; done
 kill -9 "$killed"
 { wait "$killed"; } 2>/dev/null && fail "the killed run exited 0" || true
-expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q --edge-model steepest
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q "${fast[@]}"
 [ -e "$l/results.json" ] || fail "the run after a killed one did not finish"
 # batch: one per study folder, the same way.
 mkdir -p "$tmp/busy/.articula"
@@ -170,7 +172,7 @@ expect_rc 3 "$bin/articula" run -i "$tmp/junk.nii" -o "$tmp/mine" -q
 expect_rc 2 "$bin/articula" run -i "$p/dicom" -o "$p/dicom" -q
 [ ! -e "$p/dicom/.articula" ] || fail "a failed run left .articula in the input DICOM folder"
 # One that failed after a stage wrote keeps its stamps: the next resumes.
-expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/part" --until sample -q --edge-model steepest
+expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/part" --until sample -q "${fast[@]}"
 expect_rc 2 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$tmp/part" --models nosuch -q
 [ -e "$tmp/part/.articula/sample.json" ] || fail "a failed run removed the stamps of the stages it had done"
 

@@ -326,7 +326,10 @@ TEST(FitHierarchy, ExactNearSphericalCapsReachZero) {
       std::mt19937 rng(seed);
       const double half_angle = std::uniform_real_distribution<double>(70.0, 110.0)(rng) * M_PI / 180.0;
       const Eigen::MatrixX3d pts = articula::fit::syntheticCap(truth, half_angle, 1500, 0.0, seed);
-      const Summary s = articula::fit::fitHierarchy(pts, Options{});
+      Options o;  // the fits alone: their intervals, a third of the time under the sanitizers, are tested elsewhere
+      o.span_other_optima = false;
+      o.uncertainty = articula::fit::UncertaintyMethod::Independent;
+      const Summary s = articula::fit::fitHierarchy(pts, o);
       EXPECT_LE(s.fit(families[f]).rms_mm, 0.01) << articula::geometry::modelName(families[f]) << " seed " << seed;
       expectNested(s);
     }
