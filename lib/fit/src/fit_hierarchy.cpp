@@ -907,6 +907,7 @@ void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const
                                                all_points.rows()) *
                        static_cast<double>(points.rows()) / static_cast<double>(all_points.rows());
   if (!(bound > 0)) return;
+  const VectorXd own = distance::signedDistances(reported.parameters, points, o.threads);
   Options local = o;
   local.strategy = Strategy::Local;
   local.restarts = 0;
@@ -924,7 +925,11 @@ void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const
     for (auto i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
       const Fitted f = fitModel(model, {starts[i]}, bounds, points, local);
       const bool same = (f.fit.parameters.center - reported.parameters.center).norm() < 1e-6;
-      if (same || !(f.fit.sse_mm2 <= sse + bound)) continue;
+      // Taken in unless the data rule it out: beyond the bound and by its lean along the difference.
+      if (same || !(f.fit.sse_mm2 <= sse + bound ||
+                    couldBeTheTruth(own, distance::signedDistances(f.fit.parameters, points, 1), points,
+                                    reported.uncertainty.correlation)))
+        continue;
       found[i] = OtherOptimum{f.fit.parameters, f.fit.sse_mm2,
                               parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty, o.edge_offset, 1)};
     }
@@ -932,7 +937,7 @@ void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const
   std::vector<OtherOptimum> others;
   for (auto& f : found)
     if (f) others.push_back(std::move(*f));
-  spanOtherOptima(reported.parameters, sse, bound, others, reported.uncertainty);
+  spanOtherOptima(reported.parameters, bound, others, reported.uncertainty);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/pose.hpp"
 
 namespace articula::fit {
@@ -40,8 +41,16 @@ double likelihoodRatioBoundMm2(const geometry::ShapeParameters& fitted, const Pa
   return kChiSquare1At95 * sse_mm2 / static_cast<double>(points - free) * design;
 }
 
-void spanOtherOptima(const geometry::ShapeParameters& fitted, double sse_mm2, double bound_mm2,
-                     const std::vector<OtherOptimum>& others, ParameterUncertainty& u) {
+bool couldBeTheTruth(const Eigen::VectorXd& own, const Eigen::VectorXd& theirs, const Eigen::MatrixX3d& points,
+                     const ResidualCorrelation& errors) {
+  constexpr double kOneSided95 = 1.6448536269514722;
+  const Eigen::VectorXd d = own - theirs;
+  const double variance = covarianceGram(points, d, errors)(0, 0);
+  return variance > 0 && -theirs.dot(d) <= kOneSided95 * std::sqrt(variance);
+}
+
+void spanOtherOptima(const geometry::ShapeParameters& fitted, double bound_mm2, const std::vector<OtherOptimum>& others,
+                     ParameterUncertainty& u) {
   const auto names = geometry::parameterNames(fitted.model);
   const auto kinds = geometry::parameterKinds(fitted.model);
   if (u.standard_error.size() != static_cast<Eigen::Index>(names.size())) return;
@@ -61,7 +70,7 @@ void spanOtherOptima(const geometry::ShapeParameters& fitted, double sse_mm2, do
   int spanned = 0;
   for (const OtherOptimum& other : others) {
     const ParameterUncertainty& v = other.uncertainty;
-    if (!(other.sse_mm2 <= sse_mm2 + bound_mm2) || other.parameters.model != fitted.model ||
+    if (other.parameters.model != fitted.model ||
         v.standard_error.size() != u.standard_error.size())
       continue;
     for (int i = 0; i < 3; ++i) {

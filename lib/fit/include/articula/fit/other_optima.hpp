@@ -10,16 +10,21 @@
 // them (docs/benchmarks.md, "Model selection and intervals on caps"), and
 // 53 of 60 ovoid caps had another optimum within the bound below. The
 // centre's and semi-axes' intervals are therefore widened to take in every
-// other optimum whose sum of squares lies within the likelihood-ratio bound
-// of the best (chi^2_1 at 95 % times the residuals' variance, times the
-// design effect the sandwich found for the least-determined centre
-// coordinate), each with its own interval. The egg terms and angles of
+// other optimum the data do not rule out, each with its own interval: one
+// whose sum of squares lies within the likelihood-ratio bound of the best
+// (chi^2_1 at 95 % times the residuals' variance, times the design effect
+// the sandwich found for the least-determined centre coordinate), or one
+// that, taken as the truth, errors of the fit's covariance could have made
+// look as much worse as it does (the caller's test along the two surfaces'
+// difference: a smooth difference, which correlated errors mimic, is ruled
+// out only by a larger rise than the bound's). The egg terms and angles of
 // another labelling describe another frame and are not compared: their
 // intervals stay those of the reported optimum's basin.
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "articula/fit/residual_correlation.hpp"
 #include "articula/fit/uncertainty.hpp"
 #include "articula/geometry/shape.hpp"
 
@@ -41,14 +46,28 @@ struct OtherOptimum {
 double likelihoodRatioBoundMm2(const geometry::ShapeParameters& fitted, const ParameterUncertainty& u, double sse_mm2,
                                Eigen::Index points);
 
+/// Whether errors of covariance `errors` (residual_correlation.hpp) about
+/// another optimum, whose residuals on `points` are `theirs`, could have
+/// favoured the reported one (residuals `own`) as much as they do. With
+/// d = own - theirs the reported sum of squares is the other's + 2
+/// theirs.d + |d|^2, so the other's residuals lean towards the reported
+/// surface by -theirs.d = (rise + |d|^2) / 2; were the other the truth, that
+/// lean would be normal with variance d^T Sigma d. False when it passes
+/// 1.645 standard deviations (one-sided 95 %). Correlated errors mimic a
+/// smooth difference between two surfaces, so this admits rises many times
+/// the likelihood-ratio bound, which takes the correlation from the
+/// centre's standard error alone.
+bool couldBeTheTruth(const Eigen::VectorXd& own, const Eigen::VectorXd& theirs, const Eigen::MatrixX3d& points,
+                     const ResidualCorrelation& errors);
+
 /// Widens the intervals of `fitted`'s centre (t1..t3) and semi-axes (a c0x,
 /// b c0y, c; each matched to the other optimum's axis most nearly parallel)
-/// to take in each of `others` whose sum of squares is at most `sse_mm2 +
-/// bound_mm2`, with that optimum's own interval (its value alone where that
-/// is not finite). A widened standard error
+/// to take in each of `others` (the optima the data do not rule out), with
+/// that optimum's own interval (its value alone where that is not finite);
+/// `bound_mm2` is recorded. A widened standard error
 /// becomes its interval's half width over 1.96 (the interval may be
 /// asymmetric); one whose interval grows useless is listed as not identifiable.
-void spanOtherOptima(const geometry::ShapeParameters& fitted, double sse_mm2, double bound_mm2,
-                     const std::vector<OtherOptimum>& others, ParameterUncertainty& u);
+void spanOtherOptima(const geometry::ShapeParameters& fitted, double bound_mm2, const std::vector<OtherOptimum>& others,
+                     ParameterUncertainty& u);
 
 }  // namespace articula::fit
