@@ -928,7 +928,7 @@ void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const
       // Taken in unless the data rule it out: beyond the bound and by its lean along the difference.
       if (same || !(f.fit.sse_mm2 <= sse + bound ||
                     couldBeTheTruth(own, distance::signedDistances(f.fit.parameters, points, 1), points,
-                                    reported.uncertainty.correlation)))
+                                    reported.uncertainty.correlation, static_cast<int>(starts.size()))))
         continue;
       found[i] = OtherOptimum{f.fit.parameters, f.fit.sse_mm2,
                               parameterUncertainty(f.fit.parameters, points, f.feet, o.uncertainty, o.edge_offset, 1)};

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include <boost/math/distributions/normal.hpp>
+
 #include "articula/fit/residual_correlation.hpp"
 #include "articula/geometry/pose.hpp"
 
@@ -42,11 +44,12 @@ double likelihoodRatioBoundMm2(const geometry::ShapeParameters& fitted, const Pa
 }
 
 bool couldBeTheTruth(const Eigen::VectorXd& own, const Eigen::VectorXd& theirs, const Eigen::MatrixX3d& points,
-                     const ResidualCorrelation& errors) {
-  constexpr double kOneSided95 = 1.6448536269514722;
+                     const ResidualCorrelation& errors, int alternatives) {
+  const double level = 0.05 / std::max(alternatives, 1);
+  const double z = boost::math::quantile(boost::math::complement(boost::math::normal(), level));
   const Eigen::VectorXd d = own - theirs;
   const double variance = covarianceGram(points, d, errors)(0, 0);
-  return variance > 0 && -theirs.dot(d) <= kOneSided95 * std::sqrt(variance);
+  return variance > 0 && -theirs.dot(d) <= z * std::sqrt(variance);
 }
 
 void spanOtherOptima(const geometry::ShapeParameters& fitted, double bound_mm2, const std::vector<OtherOptimum>& others,

@@ -52,13 +52,15 @@ double likelihoodRatioBoundMm2(const geometry::ShapeParameters& fitted, const Pa
 /// d = own - theirs the reported sum of squares is the other's + 2
 /// theirs.d + |d|^2, so the other's residuals lean towards the reported
 /// surface by -theirs.d = (rise + |d|^2) / 2; were the other the truth, that
-/// lean would be normal with variance d^T Sigma d. False when it passes
-/// 1.645 standard deviations (one-sided 95 %). Correlated errors mimic a
-/// smooth difference between two surfaces, so this admits rises many times
-/// the likelihood-ratio bound, which takes the correlation from the
-/// centre's standard error alone.
+/// lean would be normal with variance d^T Sigma d. False when it passes the
+/// one-sided 5 % point over `alternatives` (Bonferroni: the reported optimum
+/// is the best of that many others, so the truth's lean towards it is the
+/// largest of as many chances; 2.33 standard deviations for five).
+/// Correlated errors mimic a smooth difference between two surfaces, so
+/// this admits rises many times the likelihood-ratio bound, which takes the
+/// correlation from the centre's standard error alone.
 bool couldBeTheTruth(const Eigen::VectorXd& own, const Eigen::VectorXd& theirs, const Eigen::MatrixX3d& points,
-                     const ResidualCorrelation& errors);
+                     const ResidualCorrelation& errors, int alternatives = 1);
 
 /// Widens the intervals of `fitted`'s centre (t1..t3) and semi-axes (a c0x,
 /// b c0y, c; each matched to the other optimum's axis most nearly parallel)
