@@ -15,7 +15,7 @@
 // (chi^2_1 at 95 % times the residuals' variance, times the design effect
 // the sandwich found for the least-determined centre coordinate), or one
 // that, taken as the truth, errors of the fit's covariance could have made
-// look as much worse as it does (the caller's test along the two surfaces'
+// look as much worse as it does (couldBeTheTruth, along the two surfaces'
 // difference: a smooth difference, which correlated errors mimic, is ruled
 // out only by a larger rise than the bound's). The egg terms and angles of
 // another labelling describe another frame and are not compared: their
