@@ -899,15 +899,14 @@ void spanOptimaOfLabellings(const Fitted& ellipsoid, const Bounds& bounds, const
                    ModelFit& reported) {
   const Eigen::MatrixX3d points = subsample(all_points, kOtherOptimaPoints);
   const ShapeModel model = reported.parameters.model;
-  double sse = reported.sse_mm2;
-  Eigen::MatrixX3d feet;
-  if (points.rows() != all_points.rows()) exactRms(reported.parameters, points, sse, feet, o.threads);
   // The bound on all the points' sum of squares, scaled to the subsample's as its rises are.
   const double bound = likelihoodRatioBoundMm2(reported.parameters, reported.uncertainty, reported.sse_mm2,
                                                all_points.rows()) *
                        static_cast<double>(points.rows()) / static_cast<double>(all_points.rows());
   if (!(bound > 0)) return;
+  // The reported optimum's residuals on the points compared, and their sum of squares.
   const VectorXd own = distance::signedDistances(reported.parameters, points, o.threads);
+  const double sse = points.rows() == all_points.rows() ? reported.sse_mm2 : own.squaredNorm();
   Options local = o;
   local.strategy = Strategy::Local;
   local.restarts = 0;
