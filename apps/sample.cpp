@@ -49,7 +49,7 @@ class SampleCommand : public cli::Command {
     cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
     const mesh::TriangleMesh m = mesh::readMesh(input_);
-    const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options);
+    const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options, m.ct_edge_found);
     Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3), Nsel(P.rows(), 3);
     for (size_t i = 0; i < sel.indices.size(); ++i) {
       P.row(static_cast<Eigen::Index>(i)) = m.vertices.row(sel.indices[i]);
@@ -89,6 +89,8 @@ class SampleCommand : public cli::Command {
         {"reduced_points", ds.reduced},
         {"percentage", ds.original ? 100.0 * static_cast<double>(ds.reduced) / static_cast<double>(ds.original) : 0.0},
         {"termination", ds.termination},
+        {"vertices_without_ct_edge_left_out", m.ct_edge_found.empty() ? nlohmann::json(nullptr)
+                                                                       : nlohmann::json(sel.without_ct_edge_left_out)},
         {"provenance", provenanceJson({params, {input_}, common.seed})}};
     if (select_options.mode == sampling::SelectOptions::Mode::Auto)
       summary["sphere"] = {{"center_mm", {sel.sphere_center[0], sel.sphere_center[1], sel.sphere_center[2]}},

@@ -228,6 +228,71 @@ TEST(Mesh, LabelAboveAFlattenedDomeMovesOntoTheBone) {
   EXPECT_LT(std::sqrt(sum[0] / count[0]), 0.3) << "where the head is round";
 }
 
+/// A head of radius 20 mm (a 1.5 mm cortex at 700 HU over 200 HU cancellous
+/// bone, soft tissue at 40 HU, blurred by 0.6 mm across the surface) on a
+/// neck of radius 13 mm along +x, on 1 mm voxels; and the head's label as a
+/// watershed between head and neck cuts it: the bone within 20.5 mm of the
+/// head's centre, so that across the neck the label ends inside bone.
+struct HeadOnNeck {
+  Eigen::Vector3d centre{10.0, -5.0, 3.0};
+  double radius_mm = 20.0, neck_radius_mm = 13.0, cut_radius_mm = 20.5;
+  imaging::Volume ct;
+  imaging::Label label;
+  /// Whether a point `d` from the centre lies on the label's cut (well inside the neck).
+  bool onCut(const Eigen::Vector3d& d) const { return d.x() > 0 && d.tail<2>().norm() < neck_radius_mm - 2.0; }
+};
+
+HeadOnNeck headOnNeck() {
+  HeadOnNeck h;
+  const auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  imaging::ImageGeometry g;
+  g.size = Eigen::Vector3i(64, 56, 56);
+  g.origin = h.centre - Eigen::Vector3d(27.5, 27.5, 27.5);
+  h.ct.geometry = h.label.geometry = g;
+  h.ct.voxels.resize(static_cast<size_t>(g.voxelCount()));
+  h.label.voxels.resize(static_cast<size_t>(g.voxelCount()));
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const Eigen::Vector3d d = g.toPhysical(Eigen::Vector3d(i, j, k)) - h.centre;
+        const double depth = std::max(h.radius_mm - d.norm(), d.x() > 0 ? h.neck_radius_mm - d.tail<2>().norm() : -1e9);
+        h.ct.at(i, j, k) = static_cast<float>(40 + 660 * Phi(depth / 0.6) - 500 * Phi((depth - 1.5) / 0.6));
+        h.label.at(i, j, k) = depth > 0 && d.norm() < h.cut_radius_mm;
+      }
+  return h;
+}
+
+// Where the label ends inside bone (the cut through the neck) the CT shows
+// no edge: those vertices are marked, the head's own are not, and a .vtp
+// keeps the marks.
+TEST(Mesh, VerticesOnACutThroughBoneAreMarkedAsWithoutAnEdge) {
+  const HeadOnNeck h = headOnNeck();
+  mesh::TriangleMesh m = mesh::extractSurface(h.label, {});
+  EXPECT_TRUE(m.ct_edge_found.empty());
+  mesh::EdgeSnapOptions snap;
+  snap.edge_model = mesh::EdgeModel::SteepestFall;  // the marks come from the edge search either model starts from
+  mesh::EdgeSnapSummary summary;
+  mesh::snapToEdges(m, h.ct, snap, &summary);
+  ASSERT_TRUE(summary.moved);
+  ASSERT_EQ(m.ct_edge_found.size(), static_cast<size_t>(m.vertices.rows()));
+  int cut = 0, cut_found = 0, head = 0, head_found = 0;
+  for (Eigen::Index v = 0; v < m.vertices.rows(); ++v) {
+    const Eigen::Vector3d d = m.vertices.row(v).transpose() - h.centre;
+    const bool found = m.ct_edge_found[static_cast<size_t>(v)] != 0;
+    if (h.onCut(d)) ++cut, cut_found += found;
+    if (d.x() < 0) ++head, head_found += found;
+  }
+  EXPECT_GT(cut, 100);
+  EXPECT_LT(cut_found, 0.02 * cut) << cut_found << " of " << cut << " vertices on the cut";
+  EXPECT_GT(head_found, 0.98 * head) << head_found << " of " << head << " vertices on the head";
+  RecordProperty("cut_vertices", cut);
+  RecordProperty("cut_vertices_with_an_edge", cut_found);
+  const auto dir = testing::scratch("cut_marks");
+  mesh::writeMesh(dir / "m.vtp", m);
+  EXPECT_EQ(mesh::readMesh(dir / "m.vtp").ct_edge_found, m.ct_edge_found);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Mesh, EmptyLabelIsAnInputError) {
   imaging::Label label;
   label.geometry.size = Eigen::Vector3i(4, 4, 4);

@@ -1,7 +1,8 @@
 // Sampling: the automatic articular selection of the phantom's segmented and
 // meshed head lies on the true head (0.5 voxel RMS, centre within 0.5 mm),
 // and an ellipsoidal head is taken whole without the start of its neck
-// (the concave surface where the neck rises);
+// (the concave surface where the neck rises), nor the label's cut through
+// the neck (where the CT shows no edge);
 // the open-ball down-sampling keeps points at least r apart, covers every
 // dropped point within r, is seeded, and removes duplicates and outliers.
 #include <random>
@@ -14,6 +15,7 @@
 #include "articula/imaging/segment.hpp"
 #include "articula/mesh/mesh.hpp"
 #include "articula/sampling/downsample.hpp"
+#include "articula/phantom/phantom.hpp"
 #include "articula/sampling/select.hpp"
 #include "ct_test_support.hpp"
 
@@ -132,6 +134,46 @@ TEST(Sampling, PhantomChainPutsArticularPointsOnTheTrueHead) {
       EXPECT_NEAR(sel.sphere_radius, p.head.radii[0], 0.5);
     }
   }
+}
+
+// Across the neck the segmented head's label ends inside bone, where the
+// watershed cut it from the neck: about a head's radius from the centre,
+// normals along the neck, so the cut passes the band and the normals' test
+// (a phantom of the robustness matrix's, at coarser voxels). The mesh marks
+// it, as the CT shows no edge there, and the selection leaves it out.
+TEST(Sampling, TheLabelsCutThroughTheNeckIsNoArticularSurface) {
+  phantom::PhantomOptions o;
+  o.seed = 201;
+  o.model = geometry::ShapeModel::Superellipsoid;
+  o.head_radius_mm = 17.6;
+  o.spacing = Eigen::Vector3d(1.0, 1.0, 2.0);
+  o.exact_depth = true;
+  const phantom::Phantom p = phantom::makePhantom(o);
+  mesh::TriangleMesh m = mesh::extractSurface(imaging::segmentHead(p.ct, {}), {});
+  mesh::EdgeSnapOptions snap;
+  snap.edge_model = mesh::EdgeModel::SteepestFall;  // the marks come from the edge search either model starts from
+  mesh::snapToEdges(m, p.ct, snap);
+  // Selected vertices 2.5 and 4 mm inside along their normals still in the true femur: not on its surface.
+  const auto buried = [&](const sampling::Selection& sel) {
+    int count = 0;
+    const auto inFemur = [&](const Eigen::Vector3d& x) {
+      const Eigen::Vector3i i = p.femur.geometry.toIndex(x).array().round().cast<int>();
+      return (i.array() >= 0).all() && (i.array() < p.femur.geometry.size.array()).all() && p.femur.at(i[0], i[1], i[2]) != 0;
+    };
+    for (int v : sel.indices) {
+      const Eigen::Vector3d x = m.vertices.row(v).transpose(), n = m.normals.row(v).transpose();
+      count += inFemur(x + 2.5 * n) && inFemur(x + 4.0 * n);
+    }
+    return count;
+  };
+  const sampling::Selection unmarked = sampling::selectArticular(m.vertices, m.normals, m.triangles, {});
+  EXPECT_GT(buried(unmarked), 20);  // what the marks are for
+  const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, {}, m.ct_edge_found);
+  EXPECT_EQ(buried(sel), 0);
+  EXPECT_GE(sel.without_ct_edge_left_out, buried(unmarked));
+  EXPECT_GT(sel.indices.size(), 0.9 * unmarked.indices.size());
+  RecordProperty("buried_vertices_unmarked", buried(unmarked));
+  RecordProperty("vertices_without_ct_edge_left_out", sel.without_ct_edge_left_out);
 }
 
 Eigen::MatrixX3d randomSpherePoints(int n, unsigned seed) {

@@ -126,7 +126,7 @@ vtkSmartPointer<vtkPolyData> withNormals(vtkPolyData* input) {
 TriangleMesh fromVtk(vtkPolyData* poly) {
   points::MeshFile m = points::meshFromPolyData(poly);
   for (Eigen::Index v = 0; v < m.normals.rows(); ++v) m.normals.row(v) = Eigen::RowVector3d(m.normals.row(v)).normalized();
-  return {std::move(m.vertices), std::move(m.normals), std::move(m.triangles)};
+  return {std::move(m.vertices), std::move(m.normals), std::move(m.triangles), std::move(m.ct_edge_found)};
 }
 
 vtkSmartPointer<vtkPolyData> toVtk(const TriangleMesh& mesh) {
@@ -149,6 +149,12 @@ vtkSmartPointer<vtkPolyData> toVtk(const TriangleMesh& mesh) {
     for (Eigen::Index v = 0; v < mesh.normals.rows(); ++v)
       normals->InsertNextTuple3(mesh.normals(v, 0), mesh.normals(v, 1), mesh.normals(v, 2));
     poly->GetPointData()->SetNormals(normals);
+  }
+  if (mesh.ct_edge_found.size() == static_cast<size_t>(mesh.vertices.rows())) {
+    vtkNew<vtkUnsignedCharArray> found;
+    found->SetName(points::kCtEdgeFoundArray);
+    for (const unsigned char f : mesh.ct_edge_found) found->InsertNextValue(f);
+    poly->GetPointData()->AddArray(found);
   }
   return poly;
 }
@@ -637,6 +643,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
       neighbours[static_cast<size_t>(a)].push_back(b);
       neighbours[static_cast<size_t>(b)].push_back(a);
     }
+  mesh.ct_edge_found.assign(found.begin(), found.end());
   if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), shift, found);
   for (Eigen::Index v = 0; v < n; ++v) {
@@ -744,6 +751,7 @@ TriangleMesh readMesh(const fs::path& path) {
   TriangleMesh mesh;
   mesh.vertices = std::move(file.vertices);
   mesh.triangles = std::move(file.triangles);
+  mesh.ct_edge_found = std::move(file.ct_edge_found);
   mesh.normals = file.normals.rows() == mesh.vertices.rows() ? std::move(file.normals)
                                                              : fromVtk(withNormals(toVtk(mesh))).normals;
   return mesh;

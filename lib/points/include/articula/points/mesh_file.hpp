@@ -6,6 +6,7 @@
 // stays inside lib/points.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -15,7 +16,13 @@ struct MeshFile {
   Eigen::MatrixX3d vertices;   // #V x 3, LPS millimetres
   Eigen::MatrixX3d normals;    // #V x 3 point normals as the file has them, or 0 rows
   Eigen::MatrixX3i triangles;  // #F x 3, 0-based (polygons triangulated), possibly 0 rows
+  /// Per vertex, a .vtp's point array kCtEdgeFoundArray (articula mesh: 1
+  /// where the CT showed the bone's edge), or empty when the file has none.
+  std::vector<unsigned char> ct_edge_found;
 };
+
+/// The .vtp point array in which the mesh stage marks the vertices on the CT's bone edge.
+inline constexpr const char* kCtEdgeFoundArray = "CtEdgeFound";
 
 /// Reads a mesh by extension (case-insensitive). Throws InputError naming
 /// the file: missing, another extension, VTK's first error, no vertices.
