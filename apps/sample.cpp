@@ -50,6 +50,15 @@ class SampleCommand : public cli::Command {
 
     const mesh::TriangleMesh m = mesh::readMesh(input_);
     const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options, m.ct_edge_found);
+    nlohmann::json warnings = nlohmann::json::array();
+    if (sel.without_ct_edge_kept > 0) {
+      warnings.push_back(std::to_string(sel.without_ct_edge_kept) + " of " + std::to_string(sel.indices.size()) +
+                         " articular vertices show no bone edge in the CT, and fewer than " +
+                         std::to_string(select_options.min_points) +
+                         " do: all are kept, and a cut through bone (where the head was cut from its neck) may be "
+                         "among them");
+      log::warn("sample: " + warnings.back().get<std::string>());
+    }
     Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3), Nsel(P.rows(), 3);
     for (size_t i = 0; i < sel.indices.size(); ++i) {
       P.row(static_cast<Eigen::Index>(i)) = m.vertices.row(sel.indices[i]);
@@ -91,6 +100,9 @@ class SampleCommand : public cli::Command {
         {"termination", ds.termination},
         {"vertices_without_ct_edge_left_out", m.ct_edge_found.empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(sel.without_ct_edge_left_out)},
+        {"vertices_without_ct_edge_kept", m.ct_edge_found.empty() ? nlohmann::json(nullptr)
+                                                                   : nlohmann::json(sel.without_ct_edge_kept)},
+        {"warnings", warnings},
         {"provenance", provenanceJson({params, {input_}, common.seed})}};
     if (select_options.mode == sampling::SelectOptions::Mode::Auto)
       summary["sphere"] = {{"center_mm", {sel.sphere_center[0], sel.sphere_center[1], sel.sphere_center[2]}},

@@ -111,6 +111,10 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
     if (edges.contains("cortex_model_note") && edges.at("cortex_model_note").is_string())
       in.stage_warnings.push_back("mesh: " + edges.at("cortex_model_note").get<std::string>());
   }
+  const fs::path sample_summary = folder / "points.ply.json";
+  if (fs::exists(sample_summary))
+    for (const auto& w : readStageJson(sample_summary).value("warnings", json::array()))
+      if (w.is_string()) in.stage_warnings.push_back("sample: " + w.get<std::string>());
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);
