@@ -49,14 +49,13 @@ class SampleCommand : public cli::Command {
     cli::refuseExistingOutputs({output_, output_.string() + ".json"}, common.force);
 
     const mesh::TriangleMesh m = mesh::readMesh(input_);
-    const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options, m.ct_edge_found);
+    const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, select_options, m.cut_through_bone);
     nlohmann::json warnings = nlohmann::json::array();
-    if (sel.without_ct_edge_kept > 0) {
-      warnings.push_back(std::to_string(sel.without_ct_edge_kept) + " of " + std::to_string(sel.indices.size()) +
-                         " articular vertices show no bone edge in the CT, and fewer than " +
-                         std::to_string(select_options.min_points) +
-                         " do: all are kept, and a cut through bone (where the head was cut from its neck) may be "
-                         "among them");
+    if (sel.cut_through_bone_kept > 0) {
+      warnings.push_back(std::to_string(sel.cut_through_bone_kept) + " of " + std::to_string(sel.indices.size()) +
+                         " articular vertices lie where the label ends inside bone (no edge in the CT), and "
+                         "without them fewer than " + std::to_string(select_options.min_points) +
+                         " would remain: all are kept, and the cut where the head was cut from its neck may be among them");
       log::warn("sample: " + warnings.back().get<std::string>());
     }
     Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3), Nsel(P.rows(), 3);
@@ -98,10 +97,10 @@ class SampleCommand : public cli::Command {
         {"reduced_points", ds.reduced},
         {"percentage", ds.original ? 100.0 * static_cast<double>(ds.reduced) / static_cast<double>(ds.original) : 0.0},
         {"termination", ds.termination},
-        {"vertices_without_ct_edge_left_out", m.ct_edge_found.empty() ? nlohmann::json(nullptr)
-                                                                       : nlohmann::json(sel.without_ct_edge_left_out)},
-        {"vertices_without_ct_edge_kept", m.ct_edge_found.empty() ? nlohmann::json(nullptr)
-                                                                   : nlohmann::json(sel.without_ct_edge_kept)},
+        {"cut_through_bone_left_out", m.cut_through_bone.empty() ? nlohmann::json(nullptr)
+                                                                  : nlohmann::json(sel.cut_through_bone_left_out)},
+        {"cut_through_bone_kept", m.cut_through_bone.empty() ? nlohmann::json(nullptr)
+                                                              : nlohmann::json(sel.cut_through_bone_kept)},
         {"warnings", warnings},
         {"provenance", provenanceJson({params, {input_}, common.seed})}};
     if (select_options.mode == sampling::SelectOptions::Mode::Auto)

@@ -176,19 +176,19 @@ import json, sys
 check = next(c for c in json.load(open(sys.argv[1]))["qc"]["checks"] if c["name"] == "stage_warnings")
 assert check["status"] == "warn" and "mesh: the CT's point-spread could not be estimated" in check["reason"], check
 PY
-# So is the sample stage's: articular vertices without a CT edge kept.
+# So is the sample stage's: articular vertices on the label's cut through bone kept.
 python3 - "$tmp/r/points.ply.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert d["vertices_without_ct_edge_kept"] == 0 and d["vertices_without_ct_edge_left_out"] >= 0, d
-d["warnings"] = ["60 of 150 articular vertices show no bone edge in the CT, and fewer than 100 do: all are kept"]
+assert d["cut_through_bone_kept"] == 0 and d["cut_through_bone_left_out"] >= 0, d
+d["warnings"] = ["60 of 150 articular vertices lie where the label ends inside bone (no edge in the CT), and without them fewer than 100 would remain: all are kept"]
 json.dump(d, open(sys.argv[1], "w"), indent=2)
 PY
 expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
 python3 - "$tmp/r/results.json" <<'PY'
 import json, sys
 check = next(c for c in json.load(open(sys.argv[1]))["qc"]["checks"] if c["name"] == "stage_warnings")
-assert "sample: 60 of 150 articular vertices show no bone edge" in check["reason"], check
+assert "sample: 60 of 150 articular vertices lie where the label ends inside bone" in check["reason"], check
 PY
 
 # A missing stage output: exit 3, named; nothing written.

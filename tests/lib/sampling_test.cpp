@@ -139,8 +139,8 @@ TEST(Sampling, PhantomChainPutsArticularPointsOnTheTrueHead) {
 // Across the neck the segmented head's label ends inside bone, where the
 // watershed cut it from the neck: about a head's radius from the centre,
 // normals along the neck, so the cut passes the band and the normals' test
-// (a phantom of the robustness matrix's, at coarser voxels). The mesh marks
-// it, as the CT shows no edge there, and the selection leaves it out.
+// (a phantom of the robustness matrix's). The mesh marks it, as the CT
+// shows no edge there, and the selection leaves it out.
 TEST(Sampling, TheLabelsCutThroughTheNeckIsNoArticularSurface) {
   phantom::PhantomOptions o;
   o.seed = 201;
@@ -168,12 +168,12 @@ TEST(Sampling, TheLabelsCutThroughTheNeckIsNoArticularSurface) {
   };
   const sampling::Selection unmarked = sampling::selectArticular(m.vertices, m.normals, m.triangles, {});
   EXPECT_GT(buried(unmarked), 20);  // what the marks are for
-  const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, {}, m.ct_edge_found);
+  const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, {}, m.cut_through_bone);
   EXPECT_EQ(buried(sel), 0);
-  EXPECT_GE(sel.without_ct_edge_left_out, buried(unmarked));
+  EXPECT_GE(sel.cut_through_bone_left_out, buried(unmarked));
   EXPECT_GT(sel.indices.size(), 0.9 * unmarked.indices.size());
   RecordProperty("buried_vertices_unmarked", buried(unmarked));
-  RecordProperty("vertices_without_ct_edge_left_out", sel.without_ct_edge_left_out);
+  RecordProperty("vertices_cut_through_bone_left_out", sel.cut_through_bone_left_out);
 }
 
 Eigen::MatrixX3d randomSpherePoints(int n, unsigned seed) {

@@ -126,7 +126,7 @@ vtkSmartPointer<vtkPolyData> withNormals(vtkPolyData* input) {
 TriangleMesh fromVtk(vtkPolyData* poly) {
   points::MeshFile m = points::meshFromPolyData(poly);
   for (Eigen::Index v = 0; v < m.normals.rows(); ++v) m.normals.row(v) = Eigen::RowVector3d(m.normals.row(v)).normalized();
-  return {std::move(m.vertices), std::move(m.normals), std::move(m.triangles), std::move(m.ct_edge_found)};
+  return {std::move(m.vertices), std::move(m.normals), std::move(m.triangles), std::move(m.cut_through_bone)};
 }
 
 vtkSmartPointer<vtkPolyData> toVtk(const TriangleMesh& mesh) {
@@ -150,11 +150,11 @@ vtkSmartPointer<vtkPolyData> toVtk(const TriangleMesh& mesh) {
       normals->InsertNextTuple3(mesh.normals(v, 0), mesh.normals(v, 1), mesh.normals(v, 2));
     poly->GetPointData()->SetNormals(normals);
   }
-  if (mesh.ct_edge_found.size() == static_cast<size_t>(mesh.vertices.rows())) {
-    vtkNew<vtkUnsignedCharArray> found;
-    found->SetName(points::kCtEdgeFoundArray);
-    for (const unsigned char f : mesh.ct_edge_found) found->InsertNextValue(f);
-    poly->GetPointData()->AddArray(found);
+  if (mesh.cut_through_bone.size() == static_cast<size_t>(mesh.vertices.rows())) {
+    vtkNew<vtkUnsignedCharArray> cut;
+    cut->SetName(points::kCutThroughBoneArray);
+    for (const unsigned char c : mesh.cut_through_bone) cut->InsertNextValue(c);
+    poly->GetPointData()->AddArray(cut);
   }
   return poly;
 }
@@ -643,7 +643,15 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
       neighbours[static_cast<size_t>(a)].push_back(b);
       neighbours[static_cast<size_t>(b)].push_back(a);
     }
-  mesh.ct_edge_found.assign(found.begin(), found.end());
+  // Without an edge the label ends inside bone: the cut between head and
+  // neck (on 29 of 128 phantom heads, 10-50 articular vertices 2.5-4 mm
+  // inside the femur, every one without an edge). On coarser voxels the
+  // lack of an edge tells nothing (a gap the CT does not resolve shows none
+  // either): no marks.
+  if (look_further) {
+    mesh.cut_through_bone.resize(static_cast<size_t>(n));
+    for (Eigen::Index v = 0; v < n; ++v) mesh.cut_through_bone[static_cast<size_t>(v)] = !found[static_cast<size_t>(v)];
+  }
   if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), shift, found);
   for (Eigen::Index v = 0; v < n; ++v) {
@@ -751,7 +759,7 @@ TriangleMesh readMesh(const fs::path& path) {
   TriangleMesh mesh;
   mesh.vertices = std::move(file.vertices);
   mesh.triangles = std::move(file.triangles);
-  mesh.ct_edge_found = std::move(file.ct_edge_found);
+  mesh.cut_through_bone = std::move(file.cut_through_bone);
   mesh.normals = file.normals.rows() == mesh.vertices.rows() ? std::move(file.normals)
                                                              : fromVtk(withNormals(toVtk(mesh))).normals;
   return mesh;

@@ -259,10 +259,10 @@ MeshFile meshFromPolyData(vtkPolyData* poly) {
       out.normals.row(i) << v[0], v[1], v[2];
     }
   }
-  if (vtkDataArray* found = poly->GetPointData()->GetArray(kCtEdgeFoundArray);
-      found != nullptr && found->GetNumberOfComponents() == 1 && found->GetNumberOfTuples() == n) {
-    out.ct_edge_found.resize(static_cast<size_t>(n));
-    for (vtkIdType i = 0; i < n; ++i) out.ct_edge_found[static_cast<size_t>(i)] = found->GetTuple1(i) != 0 ? 1 : 0;
+  if (vtkDataArray* cut = poly->GetPointData()->GetArray(kCutThroughBoneArray);
+      cut != nullptr && cut->GetNumberOfComponents() == 1 && cut->GetNumberOfTuples() == n) {
+    out.cut_through_bone.resize(static_cast<size_t>(n));
+    for (vtkIdType i = 0; i < n; ++i) out.cut_through_bone[static_cast<size_t>(i)] = cut->GetTuple1(i) != 0 ? 1 : 0;
   }
   if (poly->GetNumberOfPolys() > 0) {
     // Polygons as triangles (the filter keeps the points and their order);

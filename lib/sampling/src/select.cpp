@@ -246,7 +246,7 @@ void parseSelection(const std::string& text, SelectOptions& o) {
 }
 
 Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
-                          const SelectOptions& o, const std::vector<unsigned char>& ct_edge_found) {
+                          const SelectOptions& o, const std::vector<unsigned char>& cut_through_bone) {
   o.validate();
   Selection sel;
   const Eigen::Index n = V.rows();
@@ -348,27 +348,22 @@ Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, 
       throw ProcessingError(m.str());
     }
   }
-  // Where the CT showed no bone edge, the mesh is the label's boundary
-  // inside bone: the cut between head and neck, about a head's radius from
-  // its centre with normals along the neck, passes the band and the
-  // normals' test (on 29 of 128 phantom heads, 10-50 vertices lying
-  // 2.5-4 mm inside the femur, each with no edge found; 0.2-11 % of the
-  // other articular vertices had none, and lay further from the true
-  // surface). Such a vertex is no articular point. Where fewer than
-  // min_points vertices of the selection show an edge (a coarse CT: on a
-  // real hip at 3 mm slices 77 of 187), all stay: too few edges to tell a
-  // cut from the surface (the report's points_on_ct_edge_share tells).
-  if (ct_edge_found.size() == static_cast<size_t>(n)) {
-    std::vector<int> on_edge;
+  // Where the label ends inside bone (the mesh's marks: the cut between
+  // head and neck, about a head's radius from its centre with normals along
+  // the neck), the band and the normals' test pass; such a vertex is no
+  // articular point. Where fewer than min_points vertices would remain (a
+  // coarse CT that shows few edges), all stay, counted.
+  if (cut_through_bone.size() == static_cast<size_t>(n)) {
+    std::vector<int> kept;
     for (int v : sel.indices)
-      if (ct_edge_found[static_cast<size_t>(v)] != 0) on_edge.push_back(v);
-    const int without = static_cast<int>(sel.indices.size() - on_edge.size());
-    if (static_cast<int>(on_edge.size()) >= o.min_points) {
-      sel.indices = std::move(on_edge);
-      sel.without_ct_edge_left_out = without;
+      if (cut_through_bone[static_cast<size_t>(v)] == 0) kept.push_back(v);
+    const int cut = static_cast<int>(sel.indices.size() - kept.size());
+    if (static_cast<int>(kept.size()) >= o.min_points) {
+      sel.indices = std::move(kept);
+      sel.cut_through_bone_left_out = cut;
       if (o.mode == SelectOptions::Mode::Auto) fitPatchSphere(V, sel);
     } else {
-      sel.without_ct_edge_kept = without;
+      sel.cut_through_bone_kept = cut;
     }
   }
   if (static_cast<int>(sel.indices.size()) < o.min_points)

@@ -18,12 +18,12 @@ struct TriangleMesh {
   Eigen::MatrixX3d vertices;
   Eigen::MatrixX3d normals;
   Eigen::MatrixX3i triangles;
-  /// Per vertex, once snapToEdges has moved the surface: 1 where the CT
-  /// showed the bone's edge along the normal, 0 where it showed none (the
-  /// label ends inside bone: where the head was cut from the neck). Empty
-  /// when not known. Written to and read from a .vtp as the point array
-  /// points::kCtEdgeFoundArray.
-  std::vector<unsigned char> ct_edge_found;
+  /// Per vertex, once snapToEdges has moved the surface on voxels up to
+  /// imaging::kSeparateEdgesMaxVoxelMm: 1 where the label ends inside bone
+  /// (the CT shows no bone edge along the normal, as where the head was cut
+  /// from its neck), 0 elsewhere. Empty when not known. Written to and read
+  /// from a .vtp as the point array points::kCutThroughBoneArray.
+  std::vector<unsigned char> cut_through_bone;
 };
 
 enum class Smoothing { Laplacian, WindowedSinc, None };
@@ -109,7 +109,8 @@ struct EdgeSnapSummary {
 /// the cortex meets soft tissue at sub-voxel precision and not where the
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours
-/// and are marked in mesh.ct_edge_found. Normals are recomputed. The CT's grid may differ from the label's. When
+/// and, on voxels up to imaging::kSeparateEdgesMaxVoxelMm, are marked in
+/// mesh.cut_through_bone. Normals are recomputed. The CT's grid may differ from the label's. When
 /// fewer than a quarter of the vertices find an edge, nothing moves (summary tells).
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary = nullptr);

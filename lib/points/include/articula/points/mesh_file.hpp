@@ -16,13 +16,13 @@ struct MeshFile {
   Eigen::MatrixX3d vertices;   // #V x 3, LPS millimetres
   Eigen::MatrixX3d normals;    // #V x 3 point normals as the file has them, or 0 rows
   Eigen::MatrixX3i triangles;  // #F x 3, 0-based (polygons triangulated), possibly 0 rows
-  /// Per vertex, a .vtp's point array kCtEdgeFoundArray (articula mesh: 1
-  /// where the CT showed the bone's edge), or empty when the file has none.
-  std::vector<unsigned char> ct_edge_found;
+  /// Per vertex, a .vtp's point array kCutThroughBoneArray (articula mesh: 1
+  /// where the label ends inside bone), or empty when the file has none.
+  std::vector<unsigned char> cut_through_bone;
 };
 
-/// The .vtp point array in which the mesh stage marks the vertices on the CT's bone edge.
-inline constexpr const char* kCtEdgeFoundArray = "CtEdgeFound";
+/// The .vtp point array in which the mesh stage marks the vertices where the label ends inside bone.
+inline constexpr const char* kCutThroughBoneArray = "CutThroughBone";
 
 /// Reads a mesh by extension (case-insensitive). Throws InputError naming
 /// the file: missing, another extension, VTK's first error, no vertices.

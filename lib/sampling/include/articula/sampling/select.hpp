@@ -38,19 +38,19 @@ struct Selection {
   double sphere_rms_mm = 0;                           // RMS radial residual of the patch
   int ransac_spheres = 0;                             // spheres RANSAC found in the radius range
   int concave_left_out = 0;                           // Auto: the chosen patch's vertices where the surface is concave
-  int without_ct_edge_left_out = 0;                   // vertices where the CT showed no bone edge (a cut through bone)
-  int without_ct_edge_kept = 0;                       // such vertices kept: fewer than min_points showed an edge
+  int cut_through_bone_left_out = 0;                  // vertices where the label ends inside bone, left out
+  int cut_through_bone_kept = 0;                      // such vertices kept: fewer than min_points would remain
 };
 
 /// Selects the articular vertices of a mesh: #V x 3 vertices V (mm), #V x 3
 /// unit outward normals N, #F x 3 triangles F (for connectivity); where
-/// `ct_edge_found` holds a flag per vertex (mesh::TriangleMesh), the
-/// vertices on which the CT showed no bone edge are left out, unless fewer
+/// `cut_through_bone` holds a mark per vertex (mesh::TriangleMesh), the
+/// vertices where the label ends inside bone are left out, unless fewer
 /// than options.min_points would remain. Throws
 /// ProcessingError (exit 1) when no sphere of plausible radius is found and
 /// InputError when fewer than options.min_points are selected.
 Selection selectArticular(const Eigen::MatrixX3d& V, const Eigen::MatrixX3d& N, const Eigen::MatrixX3i& F,
-                          const SelectOptions& options, const std::vector<unsigned char>& ct_edge_found = {});
+                          const SelectOptions& options, const std::vector<unsigned char>& cut_through_bone = {});
 
 /// The CGAL version this build selects articular surfaces with.
 std::string cgalVersion();
