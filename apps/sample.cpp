@@ -58,6 +58,8 @@ class SampleCommand : public cli::Command {
                          " would remain: all are kept, and the cut where the head was cut from its neck may be among them");
       log::warn("sample: " + warnings.back().get<std::string>());
     }
+    // A count of the mesh's marks, null for a mesh without them.
+    const auto marked = [&m](int count) { return m.cut_through_bone.empty() ? nlohmann::json(nullptr) : nlohmann::json(count); };
     Eigen::MatrixX3d P(static_cast<Eigen::Index>(sel.indices.size()), 3), Nsel(P.rows(), 3);
     for (size_t i = 0; i < sel.indices.size(); ++i) {
       P.row(static_cast<Eigen::Index>(i)) = m.vertices.row(sel.indices[i]);
@@ -97,10 +99,8 @@ class SampleCommand : public cli::Command {
         {"reduced_points", ds.reduced},
         {"percentage", ds.original ? 100.0 * static_cast<double>(ds.reduced) / static_cast<double>(ds.original) : 0.0},
         {"termination", ds.termination},
-        {"cut_through_bone_left_out", m.cut_through_bone.empty() ? nlohmann::json(nullptr)
-                                                                  : nlohmann::json(sel.cut_through_bone_left_out)},
-        {"cut_through_bone_kept", m.cut_through_bone.empty() ? nlohmann::json(nullptr)
-                                                              : nlohmann::json(sel.cut_through_bone_kept)},
+        {"cut_through_bone_left_out", marked(sel.cut_through_bone_left_out)},
+        {"cut_through_bone_kept", marked(sel.cut_through_bone_kept)},
         {"warnings", warnings},
         {"provenance", provenanceJson({params, {input_}, common.seed})}};
     if (select_options.mode == sampling::SelectOptions::Mode::Auto)

@@ -647,10 +647,12 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   // neck (on 29 of 128 phantom heads, 10-50 articular vertices 2.5-4 mm
   // inside the femur, every one without an edge). On coarser voxels the
   // lack of an edge tells nothing (a gap the CT does not resolve shows none
-  // either): no marks.
+  // either), and nothing is marked. Set on the mesh last, so that the
+  // copies and VTK round trips for normals below do not carry them.
+  std::vector<unsigned char> cut;
   if (look_further) {
-    mesh.cut_through_bone.resize(static_cast<size_t>(n));
-    for (Eigen::Index v = 0; v < n; ++v) mesh.cut_through_bone[static_cast<size_t>(v)] = !found[static_cast<size_t>(v)];
+    cut.resize(static_cast<size_t>(n));
+    for (Eigen::Index v = 0; v < n; ++v) cut[static_cast<size_t>(v)] = !found[static_cast<size_t>(v)];
   }
   if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), shift, found);
@@ -661,6 +663,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     s.mean_abs_shift_mm += std::abs(d) / static_cast<double>(n);
   }
   mesh.normals = fromVtk(withNormals(toVtk(mesh))).normals;
+  mesh.cut_through_bone = std::move(cut);
   s.moved = true;
   if (summary) *summary = s;
 }
