@@ -3,6 +3,7 @@
 #include "articula/cli/command.hpp"
 #include "articula/core/atomic_file.hpp"
 #include "articula/core/error.hpp"
+#include "articula/core/json_file.hpp"
 #include "articula/core/output_paths.hpp"
 #include "articula/core/log.hpp"
 #include "articula/core/provenance.hpp"
@@ -49,7 +50,12 @@ class MeshCommand : public cli::Command {
     snap.validate();
     refuseOutputsOverInputs({output_, output_.string() + ".json"}, {input_, ct_});
     checkOutputTarget(output_);
-    const imaging::Label label = imaging::readLabel(input_);
+    // articula's segmentation marks its cut through bone in the label and
+    // counts those voxels in the label's sidecar; in any other label every
+    // value but 0 is bone.
+    const std::optional<nlohmann::json> sidecar = readJsonFileIfValid(input_.string() + ".json");
+    const bool marks_its_cut = sidecar && sidecar->is_object() && sidecar->contains("cut_through_bone_voxels");
+    const imaging::Label label = imaging::readLabel(input_, marks_its_cut);
     mesh::MeshSummary s;
     mesh::TriangleMesh m = mesh::extractSurface(label, options, &s);
     nlohmann::json edges = nullptr;

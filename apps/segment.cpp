@@ -116,6 +116,7 @@ class SegmentCommand : public cli::Command {
         {"edge_rms_mm", s.edge_rms_mm},
         {"threshold_voxels", s.threshold_voxels},
         {"label_voxels", s.label_voxels},
+        {"cut_through_bone_voxels", s.cut_through_bone_voxels},
         {"warnings", warnings},
         {"provenance", provenanceJson({params, inputs, -1, common.threadCount()})}};
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);

@@ -191,6 +191,19 @@ check = next(c for c in json.load(open(sys.argv[1]))["qc"]["checks"] if c["name"
 assert "sample: 60 of 150 articular vertices lie where the label ends inside bone" in check["reason"], check
 PY
 
+# The segmentation's label marks its cut through bone (its sidecar counts
+# the voxels), and the mesh stage carries the marks onto the surface; a
+# label without articula's sidecar is bone wherever it is not 0.
+cuts=$(python3 -c "import json; print(json.load(open('$tmp/r/label.nii.gz.json'))['cut_through_bone_voxels'])")
+[ "$cuts" -gt 0 ] || fail "the sphere phantom's label marks no cut through its neck"
+mkdir -p "$tmp/own" "$tmp/other"
+cp "$tmp/r/label.nii.gz" "$tmp/r/label.nii.gz.json" "$tmp/own/"
+cp "$tmp/r/label.nii.gz" "$tmp/other/"
+expect_rc 0 "$bin/articula-mesh" -i "$tmp/own/label.nii.gz" -o "$tmp/own/bone.vtp"
+expect_rc 0 "$bin/articula-mesh" -i "$tmp/other/label.nii.gz" -o "$tmp/other/bone.vtp"
+grep -q 'Name="CutThroughBone"' "$tmp/own/bone.vtp" || fail "the mesh of articula's label carries no cut"
+! grep -q 'Name="CutThroughBone"' "$tmp/other/bone.vtp" || fail "a label without articula's sidecar was read as marking its cut"
+
 # A missing stage output: exit 3, named; nothing written.
 mkdir -p "$tmp/r2/errors"
 cp "$tmp/r/points.ply" "$tmp/r2/"

@@ -153,6 +153,26 @@ TEST(ImagingIo, DamagedGzipStreamIsRefusedWithZlibsReason) {
   std::filesystem::remove_all(dir);
 }
 
+// A label's every value but 0 is bone, read as kLabelBone; the cut through
+// bone that articula's segmentation marks keeps its value when asked.
+TEST(ImagingIo, LabelValuesAreBoneUnlessTheCutIsKept) {
+  const auto dir = testing::scratch("label-values");
+  imaging::Label label;
+  label.geometry.size = Eigen::Vector3i(4, 3, 2);
+  label.voxels = {0, 1, 2, 7, 0, 2, 1, 1, 0, 0, 255, 2, 0, 1, 2, 7, 0, 2, 1, 1, 0, 0, 255, 2};
+  imaging::writeLabel(dir / "label.nii.gz", label);
+  const imaging::Label bone = imaging::readLabel(dir / "label.nii.gz");
+  const imaging::Label kept = imaging::readLabel(dir / "label.nii.gz", true);
+  ASSERT_EQ(bone.voxels.size(), label.voxels.size());
+  ASSERT_EQ(kept.voxels.size(), label.voxels.size());
+  for (size_t n = 0; n < label.voxels.size(); ++n) {
+    const std::uint8_t v = label.voxels[n];
+    EXPECT_EQ(bone.voxels[n], v == 0 ? 0 : imaging::kLabelBone) << n;
+    EXPECT_EQ(kept.voxels[n], v == 0 ? 0 : v == imaging::kLabelCutThroughBone ? v : imaging::kLabelBone) << n;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // A NIfTI-1 header (4x4x4 int16 unless changed) and its extension bytes;
 // `big` writes it big-endian.
 std::string niftiHeader(bool big, std::int16_t dim0, std::int16_t nx, std::int16_t ny, std::int16_t nz,

@@ -176,6 +176,49 @@ TEST(Sampling, TheLabelsCutThroughTheNeckIsNoArticularSurface) {
   RecordProperty("vertices_cut_through_bone_left_out", sel.cut_through_bone_left_out);
 }
 
+// On 3 mm slices the CT's lack of an edge tells nothing (an unresolved
+// joint gap shows none either); the segmentation marks its own cut instead:
+// the head's label voxels that border bone it does not hold, where its
+// edges cut the socket off. A phantom of the robustness matrix's 3 mm group.
+TEST(Sampling, TheLabelsOwnCutIsLeftOutOnThickSlices) {
+  phantom::PhantomOptions o;
+  o.seed = 305;
+  o.model = geometry::ShapeModel::Superellipsoid;
+  o.head_radius_mm = 23.3;
+  o.spacing = Eigen::Vector3d(1.5, 1.5, 3.0);
+  o.exact_depth = true;
+  const phantom::Phantom p = phantom::makePhantom(o);
+  imaging::SegmentSummary summary;
+  const imaging::Label label = imaging::segmentHead(p.ct, {}, &summary);
+  EXPECT_GT(summary.cut_through_bone_voxels, 0);
+  EXPECT_LT(summary.cut_through_bone_voxels, summary.label_voxels / 10);
+  mesh::TriangleMesh m = mesh::extractSurface(label, {});
+  mesh::EdgeSnapOptions snap;
+  snap.edge_model = mesh::EdgeModel::SteepestFall;  // the marks are the label's, whatever the edges
+  mesh::snapToEdges(m, p.ct, snap);
+  const auto inFemur = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3i i = p.femur.geometry.toIndex(x).array().round().cast<int>();
+    return (i.array() >= 0).all() && (i.array() < p.femur.geometry.size.array()).all() && p.femur.at(i[0], i[1], i[2]) != 0;
+  };
+  // Selected vertices 3 and 4.5 mm inside along their normals still in the
+  // true femur (beyond a 3 mm slice's partial volume): not on its surface.
+  const auto buried = [&](const sampling::Selection& sel) {
+    int count = 0;
+    for (int v : sel.indices) {
+      const Eigen::Vector3d x = m.vertices.row(v).transpose(), n = m.normals.row(v).transpose();
+      count += inFemur(x + 3.0 * n) && inFemur(x + 4.5 * n);
+    }
+    return count;
+  };
+  const sampling::Selection unmarked = sampling::selectArticular(m.vertices, m.normals, m.triangles, {});
+  const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, {}, m.cut_through_bone);
+  EXPECT_GT(buried(unmarked), 10);  // what the marks are for (21 here)
+  EXPECT_LE(buried(sel), buried(unmarked) / 10);
+  EXPECT_GT(sel.indices.size(), 0.85 * unmarked.indices.size());
+  RecordProperty("buried_vertices_unmarked", buried(unmarked));
+  RecordProperty("buried_vertices_marked", buried(sel));
+}
+
 Eigen::MatrixX3d randomSpherePoints(int n, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0, 1);

@@ -627,7 +627,7 @@ ImageGeometry readImageGeometry(const fs::path& input) {
   return g;
 }
 
-Label readLabel(const fs::path& input) {
+Label readLabel(const fs::path& input, bool keep_cut) {
   if (!fs::is_regular_file(input)) throw InputError("label image not found: " + input.string());
   if (!isImageFile(input)) throw InputError("expected a label image (.nii.gz/.nrrd/.mha), found " + input.string());
   // A uint8 label (as articula writes them) is read as it is stored: a float
@@ -635,7 +635,8 @@ Label readLabel(const fs::path& input) {
   if (storedComponentType(input) == itk::IOComponentEnum::UCHAR) {
     Label label = readImageFile<std::uint8_t>(input);
     checkDirection(label.geometry.direction, input.string());
-    for (auto& v : label.voxels) v = v != 0 ? 1 : 0;
+    for (auto& v : label.voxels)
+      v = v == 0 ? 0 : keep_cut && v == kLabelCutThroughBone ? kLabelCutThroughBone : kLabelBone;
     return label;
   }
   const Image<float> raw = readImageFile<float>(input);
@@ -643,7 +644,7 @@ Label readLabel(const fs::path& input) {
   Label label;
   label.geometry = raw.geometry;
   label.voxels.resize(raw.voxels.size());
-  for (size_t n = 0; n < raw.voxels.size(); ++n) label.voxels[n] = raw.voxels[n] > 0.5f ? 1 : 0;
+  for (size_t n = 0; n < raw.voxels.size(); ++n) label.voxels[n] = raw.voxels[n] > 0.5f ? kLabelBone : 0;
   return label;
 }
 

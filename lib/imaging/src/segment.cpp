@@ -418,6 +418,21 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     }
   }
 
+  // Where the head's edges cut the socket off (measured), a label voxel
+  // that borders bone the label does not hold lies on the segmentation's
+  // own cut: the watershed's line across the neck, not the bone's surface.
+  // It is labelled kLabelCutThroughBone, so that the mesh stage can tell
+  // (docs/methods.md). Without that cut the label also borders the socket
+  // across every gap the CT does not resolve, and nothing is marked.
+  const auto bordersBone = [&](int i, int j, int k) {
+    const int step[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (const auto& d : step) {
+      const int a = i + d[0], b = j + d[1], c = k + d[2];
+      if (a < 0 || b < 0 || c < 0 || a >= bg.size[0] || b >= bg.size[1] || c >= bg.size[2]) continue;
+      if (box_mask.at(a, b, c) && !head.at(a, b, c)) return true;
+    }
+    return false;
+  };
   Label label;
   label.geometry = g;
   label.voxels.assign(volume.voxels.size(), 0);
@@ -425,8 +440,10 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     for (int j = 0; j < bg.size[1]; ++j)
       for (int i = 0; i < bg.size[0]; ++i)
         if (head.at(i, j, k)) {
-          label.at(lo[0] + i, lo[1] + j, lo[2] + k) = 1;
+          const bool cut = measured && bordersBone(i, j, k);
+          label.at(lo[0] + i, lo[1] + j, lo[2] + k) = cut ? kLabelCutThroughBone : kLabelBone;
           ++summary.label_voxels;
+          summary.cut_through_bone_voxels += cut;
         }
   if (summary.label_voxels == 0) throw ProcessingError("the head label is empty after separation");
   if (summary_out) *summary_out = summary;

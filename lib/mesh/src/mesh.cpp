@@ -2,6 +2,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
 #include <vtkFlyingEdges3D.h>
@@ -168,6 +171,37 @@ void MeshOptions::validate() const {
   if (!(decimate >= 0 && decimate < 1)) throw UsageError("--decimate: expected a fraction in [0, 1)");
 }
 
+namespace {
+
+/// Per vertex, 1 where the label voxel nearest to it is on the
+/// segmentation's cut through bone (imaging::kLabelCutThroughBone); empty
+/// when the label marks no cut.
+std::vector<unsigned char> cutMarksOfLabel(const imaging::Label& label, const Eigen::MatrixX3d& vertices) {
+  if (std::find(label.voxels.begin(), label.voxels.end(), imaging::kLabelCutThroughBone) == label.voxels.end()) return {};
+  const imaging::ImageGeometry& g = label.geometry;
+  std::vector<unsigned char> marks(static_cast<size_t>(vertices.rows()), 0);
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+    const Eigen::Vector3d x = vertices.row(v).transpose();
+    const Eigen::Vector3d index = g.toIndex(x);
+    double nearest = INFINITY;
+    // The smoothed surface lies within about a voxel of the label's voxels.
+    for (int dk = -1; dk <= 1; ++dk)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const Eigen::Vector3i ijk(static_cast<int>(std::lround(index[0])) + di, static_cast<int>(std::lround(index[1])) + dj,
+                                    static_cast<int>(std::lround(index[2])) + dk);
+          if ((ijk.array() < 0).any() || (ijk.array() >= g.size.array()).any()) continue;
+          const std::uint8_t value = label.at(ijk[0], ijk[1], ijk[2]);
+          if (value == 0) continue;
+          const double d = (g.toPhysical(ijk.cast<double>()) - x).norm();
+          if (d < nearest) nearest = d, marks[static_cast<size_t>(v)] = value == imaging::kLabelCutThroughBone;
+        }
+  }
+  return marks;
+}
+
+}  // namespace
+
 TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& options, MeshSummary* summary) {
   options.validate();
   long long voxels = 0;
@@ -223,6 +257,7 @@ TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& opti
   }
   TriangleMesh mesh = fromVtk(withNormals(poly));
   if (mesh.triangles.rows() == 0) throw ProcessingError("the iso-surface has no triangles");
+  mesh.cut_through_bone = cutMarksOfLabel(label, mesh.vertices);
   if (summary) {
     summary->label_voxels = voxels;
     summary->raw_triangles = raw;
@@ -647,11 +682,16 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
   // neck (on 29 of 128 phantom heads, 10-50 articular vertices 2.5-4 mm
   // inside the femur, every one without an edge). On coarser voxels the
   // lack of an edge tells nothing (a gap the CT does not resolve shows none
-  // either), and nothing is marked. Set on the mesh last, so that the
-  // copies and VTK round trips for normals below do not carry them.
-  std::vector<unsigned char> cut;
+  // either), and the label's own marks of its cut stay instead. Not on finer
+  // ones: those also take in a dome the segmentation could not cut from a
+  // socket bridged across a narrow gap, which has its edge (an osteoporotic
+  // head at 1 x 1 x 2 mm, its gap 1.5 mm: 242 vertices, the socket-facing
+  // check failed). Set on the mesh last, so that the copies and VTK round
+  // trips for normals below do not carry them.
+  std::vector<unsigned char> cut = std::move(mesh.cut_through_bone);
+  mesh.cut_through_bone.clear();
   if (look_further) {
-    cut.resize(static_cast<size_t>(n));
+    cut.assign(static_cast<size_t>(n), 0);
     for (Eigen::Index v = 0; v < n; ++v) cut[static_cast<size_t>(v)] = !found[static_cast<size_t>(v)];
   }
   if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);

@@ -42,6 +42,10 @@ struct Image {
 };
 
 using Volume = Image<float>;        // CT in Hounsfield units
-using Label = Image<std::uint8_t>;  // 0 background, 1 bone of interest
+using Label = Image<std::uint8_t>;  // 0 background, else bone of interest
+/// A label's values: bone of interest, and such a voxel on the segmentation's
+/// cut through bone (bordering bone the label does not hold, as where the
+/// head was cut from its neck). Every value but 0 is the bone's.
+constexpr std::uint8_t kLabelBone = 1, kLabelCutThroughBone = 2;
 
 }  // namespace articula::imaging

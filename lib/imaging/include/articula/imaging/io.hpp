@@ -68,8 +68,10 @@ void limitImagingThreads(int threads);
 /// cannot read, or an image that is not 3-D with an orthonormal direction.
 ImageGeometry readImageGeometry(const std::filesystem::path& input);
 
-/// Reads a label image (any integer type, non-zero = 1).
-Label readLabel(const std::filesystem::path& input);
+/// Reads a label image (any integer type, non-zero = kLabelBone). With
+/// `keep_cut` (a label articula's segmentation wrote), its voxels of
+/// kLabelCutThroughBone keep that value.
+Label readLabel(const std::filesystem::path& input, bool keep_cut = false);
 
 /// Writes a volume (as int16 HU) or a label (uint8) to .nii.gz/.nii/.nrrd/.mha,
 /// atomically (temporary name, then rename).

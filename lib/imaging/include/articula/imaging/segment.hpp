@@ -64,12 +64,14 @@ struct SegmentSummary {
   double edge_coverage = 0, edge_rms_mm = 0;
   long long threshold_voxels = 0;           // voxels in the HU window (within the ROI)
   long long label_voxels = 0;
+  long long cut_through_bone_voxels = 0;    // of label_voxels, those labelled kLabelCutThroughBone
   std::vector<std::string> warnings;
 };
 
-/// Labels the joint head (with whatever of its neck the watershed keeps) as 1
-/// in the volume's own grid. Throws ProcessingError (exit 1) if no head is
-/// found and InputError if the window holds no voxel.
+/// Labels the joint head (with whatever of its neck the watershed keeps) in
+/// the volume's own grid: kLabelBone, or kLabelCutThroughBone on its cut.
+/// Throws ProcessingError (exit 1) if no head is found and InputError if the
+/// window holds no voxel.
 Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSummary* summary = nullptr);
 
 }  // namespace articula::imaging

@@ -18,11 +18,13 @@ struct TriangleMesh {
   Eigen::MatrixX3d vertices;
   Eigen::MatrixX3d normals;
   Eigen::MatrixX3i triangles;
-  /// Per vertex, once snapToEdges has moved the surface on voxels up to
-  /// imaging::kSeparateEdgesMaxVoxelMm: 1 where the label ends inside bone
-  /// (the CT shows no bone edge along the normal, as where the head was cut
-  /// from its neck), 0 elsewhere. Empty when not known. Written to and read
-  /// from a .vtp as the point array points::kCutThroughBoneArray.
+  /// Per vertex, 1 where the label ends inside bone, 0 elsewhere; empty
+  /// when not known. From the label (extractSurface: the nearest voxel is
+  /// imaging::kLabelCutThroughBone, the segmentation's cut) or, once
+  /// snapToEdges has moved the surface on voxels up to
+  /// imaging::kSeparateEdgesMaxVoxelMm, instead from the CT (no bone edge
+  /// along the normal, as where the head was cut from its neck). Written to
+  /// and read from a .vtp as the point array points::kCutThroughBoneArray.
   std::vector<unsigned char> cut_through_bone;
 };
 
@@ -47,7 +49,8 @@ struct MeshSummary {
 };
 
 /// Extracts the boundary of label > 0 as an oriented triangle mesh with
-/// outward normals. Throws InputError if the label has no voxel set.
+/// outward normals, its vertices on the label's cut through bone marked.
+/// Throws InputError if the label has no voxel set.
 TriangleMesh extractSurface(const imaging::Label& label, const MeshOptions& options, MeshSummary* summary = nullptr);
 
 enum class EdgeModel { Automatic, SteepestFall, Cortex };
@@ -110,7 +113,7 @@ struct EdgeSnapSummary {
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours
 /// and, on voxels up to imaging::kSeparateEdgesMaxVoxelMm, are marked in
-/// mesh.cut_through_bone. Normals are recomputed. The CT's grid may differ
+/// mesh.cut_through_bone in place of the label's marks. Normals are recomputed. The CT's grid may differ
 /// from the label's. When fewer than a quarter of the vertices find an
 /// edge, nothing moves (summary tells).
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
