@@ -136,6 +136,22 @@ TEST(Sampling, PhantomChainPutsArticularPointsOnTheTrueHead) {
   }
 }
 
+// The selected vertices that lie in the phantom's true femur still `near`
+// and `far` mm inside along their normals: not on its surface.
+int buriedInFemur(const phantom::Phantom& p, const mesh::TriangleMesh& m, const sampling::Selection& sel, double near,
+                  double far) {
+  const auto inFemur = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3i i = p.femur.geometry.toIndex(x).array().round().cast<int>();
+    return (i.array() >= 0).all() && (i.array() < p.femur.geometry.size.array()).all() && p.femur.at(i[0], i[1], i[2]) != 0;
+  };
+  int count = 0;
+  for (int v : sel.indices) {
+    const Eigen::Vector3d x = m.vertices.row(v).transpose(), n = m.normals.row(v).transpose();
+    count += inFemur(x + near * n) && inFemur(x + far * n);
+  }
+  return count;
+}
+
 // Across the neck the segmented head's label ends inside bone, where the
 // watershed cut it from the neck: about a head's radius from the centre,
 // normals along the neck, so the cut passes the band and the normals' test
@@ -153,19 +169,7 @@ TEST(Sampling, TheLabelsCutThroughTheNeckIsNoArticularSurface) {
   mesh::EdgeSnapOptions snap;
   snap.edge_model = mesh::EdgeModel::SteepestFall;  // the marks come from the edge search either model starts from
   mesh::snapToEdges(m, p.ct, snap);
-  // Selected vertices 2.5 and 4 mm inside along their normals still in the true femur: not on its surface.
-  const auto buried = [&](const sampling::Selection& sel) {
-    int count = 0;
-    const auto inFemur = [&](const Eigen::Vector3d& x) {
-      const Eigen::Vector3i i = p.femur.geometry.toIndex(x).array().round().cast<int>();
-      return (i.array() >= 0).all() && (i.array() < p.femur.geometry.size.array()).all() && p.femur.at(i[0], i[1], i[2]) != 0;
-    };
-    for (int v : sel.indices) {
-      const Eigen::Vector3d x = m.vertices.row(v).transpose(), n = m.normals.row(v).transpose();
-      count += inFemur(x + 2.5 * n) && inFemur(x + 4.0 * n);
-    }
-    return count;
-  };
+  const auto buried = [&](const sampling::Selection& sel) { return buriedInFemur(p, m, sel, 2.5, 4.0); };
   const sampling::Selection unmarked = sampling::selectArticular(m.vertices, m.normals, m.triangles, {});
   EXPECT_GT(buried(unmarked), 20);  // what the marks are for
   const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, {}, m.cut_through_bone);
@@ -196,20 +200,8 @@ TEST(Sampling, TheLabelsOwnCutIsLeftOutOnThickSlices) {
   mesh::EdgeSnapOptions snap;
   snap.edge_model = mesh::EdgeModel::SteepestFall;  // the marks are the label's, whatever the edges
   mesh::snapToEdges(m, p.ct, snap);
-  const auto inFemur = [&](const Eigen::Vector3d& x) {
-    const Eigen::Vector3i i = p.femur.geometry.toIndex(x).array().round().cast<int>();
-    return (i.array() >= 0).all() && (i.array() < p.femur.geometry.size.array()).all() && p.femur.at(i[0], i[1], i[2]) != 0;
-  };
-  // Selected vertices 3 and 4.5 mm inside along their normals still in the
-  // true femur (beyond a 3 mm slice's partial volume): not on its surface.
-  const auto buried = [&](const sampling::Selection& sel) {
-    int count = 0;
-    for (int v : sel.indices) {
-      const Eigen::Vector3d x = m.vertices.row(v).transpose(), n = m.normals.row(v).transpose();
-      count += inFemur(x + 3.0 * n) && inFemur(x + 4.5 * n);
-    }
-    return count;
-  };
+  // Beyond a 3 mm slice's partial volume.
+  const auto buried = [&](const sampling::Selection& sel) { return buriedInFemur(p, m, sel, 3.0, 4.5); };
   const sampling::Selection unmarked = sampling::selectArticular(m.vertices, m.normals, m.triangles, {});
   const sampling::Selection sel = sampling::selectArticular(m.vertices, m.normals, m.triangles, {}, m.cut_through_bone);
   EXPECT_GT(buried(unmarked), 10);  // what the marks are for (21 here)
