@@ -113,9 +113,9 @@ struct EdgeSnapSummary {
 /// label's voxels end; shifts averaged over neighbours against CT noise,
 /// vertices without an edge (a cut through bone) follow their neighbours
 /// and, on voxels up to imaging::kSeparateEdgesMaxVoxelMm, are marked in
-/// mesh.cut_through_bone in place of the label's marks. Normals are recomputed. The CT's grid may differ
-/// from the label's. When fewer than a quarter of the vertices find an
-/// edge, nothing moves (summary tells).
+/// mesh.cut_through_bone in place of the label's marks. Normals are
+/// recomputed. The CT's grid may differ from the label's. When fewer than a
+/// quarter of the vertices find an edge, nothing moves (summary tells).
 void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOptions& options,
                  EdgeSnapSummary* summary = nullptr);
 
