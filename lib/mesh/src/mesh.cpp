@@ -182,14 +182,13 @@ std::vector<unsigned char> cutMarksOfLabel(const imaging::Label& label, const Ei
   std::vector<unsigned char> marks(static_cast<size_t>(vertices.rows()), 0);
   for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
     const Eigen::Vector3d x = vertices.row(v).transpose();
-    const Eigen::Vector3d index = g.toIndex(x);
+    const Eigen::Vector3i voxel = g.toIndex(x).array().round().cast<int>();
     double nearest = INFINITY;
     // The smoothed surface lies within about a voxel of the label's voxels.
     for (int dk = -1; dk <= 1; ++dk)
       for (int dj = -1; dj <= 1; ++dj)
         for (int di = -1; di <= 1; ++di) {
-          const Eigen::Vector3i ijk(static_cast<int>(std::lround(index[0])) + di, static_cast<int>(std::lround(index[1])) + dj,
-                                    static_cast<int>(std::lround(index[2])) + dk);
+          const Eigen::Vector3i ijk = voxel + Eigen::Vector3i(di, dj, dk);
           if ((ijk.array() < 0).any() || (ijk.array() >= g.size.array()).any()) continue;
           const std::uint8_t value = label.at(ijk[0], ijk[1], ijk[2]);
           if (value == 0) continue;
