@@ -1,5 +1,6 @@
 // Fitting synthetic caps of known shapes: parameters recovered without
 // noise, RMS near sigma with noise, the nesting guarantee, determinism.
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -487,6 +488,7 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
   Eigen::VectorXd expected_square = Eigen::VectorXd::Zero(6);
   double expected_absorbed = 0;
   const Eigen::VectorXd across = normals * slice_axis;
+  std::array<double, 5> absorbed_by_term{};
   for (int term = 0; term < 5; ++term) {
     Eigen::VectorXd f = term < 3    ? Eigen::VectorXd(normals.col(term))
                         : term == 3 ? Eigen::VectorXd(across.array().square())
@@ -496,7 +498,8 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
     const articula::fit::ModelFit refit = articula::fit::fitHierarchy(moved, o).fit(ShapeModel::Ellipsoid);
     const ShapeParameters& p = refit.parameters;
     // What the fit takes up of the field: the field's sum of squares less what it leaves.
-    expected_absorbed += 0.05 * 0.05 * f.squaredNorm() - refit.sse_mm2;
+    absorbed_by_term[term] = 0.05 * 0.05 * f.squaredNorm() - refit.sse_mm2;
+    expected_absorbed += absorbed_by_term[term];
     const Eigen::Matrix3d Rf = articula::geometry::rotationFromAngles(p.angles);
     const Eigen::Matrix3d Rt = articula::geometry::rotationFromAngles(truth.angles);
     for (int i = 0; i < 3; ++i) {
@@ -508,6 +511,11 @@ TEST(ParameterUncertainty, TheEdgeOffsetPartIsTheShiftItsFieldCauses) {
       articula::fit::parameterUncertainty(truth, cap, {}, articula::fit::UncertaintyMethod::SpatialModel, field);
   EXPECT_GT(expected_absorbed, 0.5);
   EXPECT_NEAR(u.edge_offset_absorbed_mm2, expected_absorbed, 0.05 * expected_absorbed);
+  // Per term, the diagonal of the terms' matrix (its trace the sum above).
+  ASSERT_EQ(u.edge_offset_absorbed_terms_mm2.rows(), 5);
+  EXPECT_NEAR(u.edge_offset_absorbed_terms_mm2.trace(), u.edge_offset_absorbed_mm2, 1e-12);
+  for (int term = 0; term < 5; ++term)
+    EXPECT_NEAR(u.edge_offset_absorbed_terms_mm2(term, term), absorbed_by_term[term], 0.05 * expected_absorbed) << term;
   for (int k = 0; k < 6; ++k) {
     const double expected = std::sqrt(expected_square[k]);
     EXPECT_GT(expected, 0.005) << k;  // the field moves every one of them

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include <boost/math/distributions/fisher_f.hpp>
 #include <gtest/gtest.h>
 
 #include "articula/core/error.hpp"
@@ -126,31 +127,83 @@ TEST(ModelSelection, TheNestedFTestCountsTheEffectivePoints) {
 
 // The test's degrees of freedom are the free parameters: an ovoid's c0x and
 // c0y trade with a and b (one surface), so an ovoid has 6 more than an
-// ellipsoid, not 8; and the part of the fall that the edge offset field the
-// voxels allow would give the richer model's extra parameters is not taken
-// as its gain. Closed forms: F(df1, d2) = (fall / df1) / (SSE / d2).
-TEST(ModelSelection, TheTestCountsFreeParametersAndLeavesTheEdgeFieldsPartOut) {
+// ellipsoid, not 8. The edge offset field the voxels allow adds its expected
+// part to the fall's expected value and its spread to the degrees of freedom
+// (Satterthwaite): F = fall / (s^2 df1 + mu), h = 2 (s^2 df1 + mu)^2 / (2 s^4 df1 + v).
+TEST(ModelSelection, TheTestCountsFreeParametersAndTheEdgeFieldsSpread) {
   using geometry::ShapeModel;
   EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Sphere), 4);
   EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Superellipsoid), 12);
   EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Ovoid), 15);
   EXPECT_EQ(geometry::freeParameterCount(ShapeModel::Superovoid), 18);
-  const statistics::ModelEvidence ellipsoid{"ellipsoid", 9, 1000, 10.0, 1000.0, true, 0.02};
-  const statistics::ModelEvidence ovoid{"ovoid", geometry::freeParameterCount(ShapeModel::Ovoid), 1000, 9.9, 1000.0, true,
-                                        0.07};
-  const statistics::NestedStep step = statistics::nestedFTest(ellipsoid, ovoid, 0.05);
+  statistics::ModelEvidence ellipsoid{"ellipsoid", 9, 1000, 10.0, 1000.0, true, 0.0};
+  statistics::ModelEvidence ovoid{"ovoid", geometry::freeParameterCount(ShapeModel::Ovoid), 1000, 9.9, 1000.0, true, 0.0};
+  const double s2 = 9.9 / 985;
+  // No field: the plain F test on (6, 985).
+  statistics::NestedStep step = statistics::nestedFTest(ellipsoid, ovoid, 0.05);
   EXPECT_EQ(step.df1, 6);
-  // The field takes up 0.05 mm^2 more in the ovoid: the gain is 0.05, not 0.1.
-  EXPECT_NEAR(step.f, (0.05 / 6) / (9.9 / 985), 1e-9);
+  EXPECT_NEAR(step.f, (0.1 / 6) / s2, 1e-9);
+  EXPECT_NEAR(step.df1_effective, 6.0, 1e-12);
+  // The field's terms: the ovoid takes up 0.03 and 0.02 mm^2 more of two.
+  ellipsoid.edge_offset_absorbed_terms_mm2 = Eigen::MatrixXd::Zero(5, 5);
+  ellipsoid.edge_offset_absorbed_terms_mm2(0, 0) = 0.01;
+  ovoid.edge_offset_absorbed_terms_mm2 = ellipsoid.edge_offset_absorbed_terms_mm2;
+  ovoid.edge_offset_absorbed_terms_mm2(0, 0) += 0.03;
+  ovoid.edge_offset_absorbed_terms_mm2(3, 3) += 0.02;
+  step = statistics::nestedFTest(ellipsoid, ovoid, 0.05);
+  const double mean = 6 * s2 + 0.05;
+  EXPECT_NEAR(step.f, 0.1 / mean, 1e-9);
+  EXPECT_NEAR(step.df1_effective, 2 * mean * mean / (12 * s2 * s2 + 2 * (0.03 * 0.03 + 0.02 * 0.02)), 1e-9);
+  const double h_terms = step.df1_effective;
+  // Only the sums known (an older fits.json): the field taken as one term,
+  // the widest spread.
+  statistics::ModelEvidence e_sum = ellipsoid, o_sum = ovoid;
+  e_sum.edge_offset_absorbed_terms_mm2.resize(0, 0);
+  o_sum.edge_offset_absorbed_terms_mm2.resize(0, 0);
+  e_sum.edge_offset_absorbed_mm2 = 0.01;
+  o_sum.edge_offset_absorbed_mm2 = 0.06;
+  step = statistics::nestedFTest(e_sum, o_sum, 0.05);
+  EXPECT_NEAR(step.f, 0.1 / mean, 1e-9);
+  EXPECT_NEAR(step.df1_effective, 2 * mean * mean / (12 * s2 * s2 + 2 * 0.05 * 0.05), 1e-9);
+  EXPECT_LT(step.df1_effective, h_terms);  // one term spreads more than two
   // A field the richer model takes up less of (it never can: clamped) adds nothing.
-  statistics::ModelEvidence less = ovoid;
-  less.edge_offset_absorbed_mm2 = 0.0;
-  EXPECT_NEAR(statistics::nestedFTest(ellipsoid, less, 0.05).f, (0.1 / 6) / (9.9 / 985), 1e-9);
-  // A fall the field explains whole is no gain.
-  statistics::ModelEvidence all = ovoid;
-  all.edge_offset_absorbed_mm2 = 0.5;
-  EXPECT_EQ(statistics::nestedFTest(ellipsoid, all, 0.05).f, 0.0);
-  EXPECT_FALSE(statistics::nestedFTest(ellipsoid, all, 0.05).richer_needed);
+  std::swap(o_sum.edge_offset_absorbed_mm2, e_sum.edge_offset_absorbed_mm2);
+  EXPECT_NEAR(statistics::nestedFTest(e_sum, o_sum, 0.05).f, (0.1 / 6) / s2, 1e-9);
+}
+
+// Where the simpler model is right, the richer model's gain is noise plus
+// the edge offset field's share; a field carried by one term spreads like
+// chi^2(1), several times its mean. The test must then take the richer
+// model 5 % of the time at alpha 0.05; subtracting the field's mean alone
+// took it 15-27 % of the time. Simulated: gains s^2 chi^2(6) + sum_t w_t chi^2(1).
+TEST(ModelSelection, TheTestHoldsItsLevelWhenTheEdgeFieldCarriesTheGain) {
+  const int n = 100000, draws = 20000;
+  for (const auto& [s2, weights] : std::vector<std::pair<double, std::vector<double>>>{
+           {0.001, {0.03}}, {0.005, {0.02, 0.01, 0.005}}, {0.01, {0.002}}}) {
+    statistics::ModelEvidence simpler{"ellipsoid", 9, n, NAN, static_cast<double>(n), true, 0.0};
+    statistics::ModelEvidence richer{"ovoid", 15, n, s2 * (n - 15), static_cast<double>(n), true, 0.0};
+    simpler.edge_offset_absorbed_terms_mm2 = richer.edge_offset_absorbed_terms_mm2 = Eigen::MatrixXd::Zero(5, 5);
+    for (size_t t = 0; t < weights.size(); ++t)
+      richer.edge_offset_absorbed_terms_mm2(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(t)) = weights[t];
+    std::mt19937 rng(7);
+    std::chi_squared_distribution<double> noise(6.0), term(1.0);
+    int taken = 0, taken_by_mean = 0;
+    double field_mean = 0;
+    for (double w : weights) field_mean += w;
+    for (int i = 0; i < draws; ++i) {
+      double fall = s2 * noise(rng);
+      for (double w : weights) fall += w * term(rng);
+      simpler.sse_mm2 = richer.sse_mm2 + fall;
+      taken += statistics::nestedFTest(simpler, richer, 0.05).richer_needed;
+      const double by_mean = std::max(0.0, fall - field_mean) / (6 * s2);
+      taken_by_mean += boost::math::cdf(boost::math::complement(boost::math::fisher_f(6, n - 15), by_mean)) < 0.05;
+    }
+    SCOPED_TRACE(s2);
+    EXPECT_NEAR(static_cast<double>(taken) / draws, 0.05, 0.008);
+    if (field_mean > 3 * s2 * 6) {
+      EXPECT_GT(static_cast<double>(taken_by_mean) / draws, 0.12);
+    }
+  }
 }
 
 TEST(ModelSelection, UndeterminedModelsAreNeverSelected) {

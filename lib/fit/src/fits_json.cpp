@@ -47,6 +47,9 @@ nlohmann::json modelFitJson(const ModelFit& f) {
   nlohmann::json errors = nlohmann::json::object(), intervals = nlohmann::json::object(),
                  systematic = nlohmann::json::object();
   const auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json absorbed_terms = nlohmann::json::array();
+  for (Eigen::Index r = 0; r < u.edge_offset_absorbed_terms_mm2.rows(); ++r)
+    absorbed_terms.push_back(list(Eigen::VectorXd(u.edge_offset_absorbed_terms_mm2.row(r).transpose())));
   if (u.standard_error.size() == static_cast<Eigen::Index>(names.size()))
     for (size_t i = 0; i < names.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
@@ -69,6 +72,7 @@ nlohmann::json modelFitJson(const ModelFit& f) {
           {"ci95_table_3_2", intervals},
           {"edge_offset_standard_errors_table_3_2", systematic},
           {"edge_offset_absorbed_mm2", u.edge_offset_absorbed_mm2},
+          {"edge_offset_absorbed_terms_mm2", absorbed_terms},
           {"not_identifiable", u.not_identifiable},
           {"gauge", u.gauge},
           {"uncertainty_method", u.method},

@@ -236,7 +236,8 @@ ParameterUncertainty parameterUncertainty(const geometry::ShapeParameters& fitte
     const Eigen::MatrixXd shifts = bread * field_scores;
     systematic = shifts * shifts.transpose();
     covariance += systematic;
-    out.edge_offset_absorbed_mm2 = (field_scores.transpose() * shifts).trace();
+    out.edge_offset_absorbed_terms_mm2 = field_scores.transpose() * shifts;
+    out.edge_offset_absorbed_mm2 = out.edge_offset_absorbed_terms_mm2.trace();
   }
   out.edge_offset = edge_offset;
   const double s2 = sse / static_cast<double>(n - k);

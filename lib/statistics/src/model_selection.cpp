@@ -31,7 +31,7 @@ std::vector<ModelEvidence> modelEvidence(const fit::Summary& fits, double n_eff)
     out.push_back({geometry::modelName(f.parameters.model), geometry::freeParameterCount(f.parameters.model), fits.points,
                    f.sse_mm2, std::isfinite(n_eff) ? n_eff : f.uncertainty.correlation.n_eff,
                    determinedByPoints(f.parameters.model, f.uncertainty.not_identifiable),
-                   f.uncertainty.edge_offset_absorbed_mm2});
+                   f.uncertainty.edge_offset_absorbed_mm2, f.uncertainty.edge_offset_absorbed_terms_mm2});
   return out;
 }
 
@@ -53,12 +53,27 @@ NestedStep nestedFTest(const ModelEvidence& simpler, const ModelEvidence& richer
   step.n_eff = std::sqrt(n_simpler * n_richer);
   if (step.df1 <= 0 || step.df2 <= 0 || !(richer.sse_mm2 > 0) || !std::isfinite(simpler.sse_mm2)) return step;
   // The hierarchy keeps SSE_r <= SSE_s; a hair above from rounding is no fall.
-  // Less what the edge offset field the voxels allow would give the richer
-  // model's extra parameters (a slice-shaped offset passes for an egg's terms).
-  const double field = std::max(0.0, richer.edge_offset_absorbed_mm2 - simpler.edge_offset_absorbed_mm2);
-  const double fall = std::max(0.0, simpler.sse_mm2 - richer.sse_mm2 - field);
-  step.f = (fall / step.df1) / (richer.sse_mm2 / step.df2) * step.n_eff / n;
-  step.p_value = boost::math::cdf(boost::math::complement(boost::math::fisher_f(step.df1, step.df2), step.f));
+  const double fall = std::max(0.0, simpler.sse_mm2 - richer.sse_mm2);
+  const double noise = richer.sse_mm2 / step.df2 * n / step.n_eff;  // s^2 per effective point
+  const double noise_mean = noise * step.df1, noise_variance = 2 * noise * noise * step.df1;
+  // What the edge offset field the voxels allow gives the richer model's
+  // extra parameters (a slice-shaped offset passes for an egg's terms).
+  double field_mean = 0, field_variance = 0;
+  const Eigen::MatrixXd& a_r = richer.edge_offset_absorbed_terms_mm2;
+  const Eigen::MatrixXd& a_s = simpler.edge_offset_absorbed_terms_mm2;
+  if (a_r.size() > 0 && a_r.rows() == a_r.cols() && a_r.rows() == a_s.rows() && a_r.cols() == a_s.cols()) {
+    const Eigen::MatrixXd gained = 0.5 * ((a_r - a_s) + (a_r - a_s).transpose());
+    field_mean = std::max(0.0, gained.trace());
+    if (field_mean > 0) field_variance = 2 * gained.squaredNorm();
+  } else {
+    field_mean = std::max(0.0, richer.edge_offset_absorbed_mm2 - simpler.edge_offset_absorbed_mm2);
+    field_variance = 2 * field_mean * field_mean;
+  }
+  const double mean = noise_mean + field_mean;
+  step.f = fall / mean;
+  step.df1_effective = 2 * mean * mean / (noise_variance + field_variance);
+  step.p_value =
+      boost::math::cdf(boost::math::complement(boost::math::fisher_f(step.df1_effective, step.df2), step.f));
   step.richer_needed = step.p_value < alpha;
   return step;
 }

@@ -204,14 +204,23 @@ std::string probability(double p) {
   return buffer;
 }
 
+// A step's numerator degrees of freedom: those the voxels' edge offset field
+// widened (df1_effective, one decimal), else the extra parameters.
+std::string degreesOfFreedom(const json& step) {
+  const double effective = numberAt(step, "df1_effective");
+  return std::isfinite(effective) && std::abs(effective - numberAt(step, "df1")) > 0.05 ? fixed(effective, 1)
+                                                                                          : text(step, "df1");
+}
+
 // The nested tests of the model selection: the hierarchy's steps, each at
 // alpha, and the tests the choice made at their levels.
 std::string selectionTable(const json& results) {
   const json& selection = member(results, "selection");
   std::string html = "<h3>Model selection</h3>\n<p class=\"note\">Each step tests whether the richer model's extra "
-                     "parameters are needed: F = (fall of the SSE per extra parameter) / (the richer model's residual "
-                     "variance) &times; n<sub>eff</sub> / n, so that correlated points count as the independent points they "
-                     "are worth (n<sub>eff</sub>: the cap's points for errors shared over " +
+                     "parameters are needed: F = (fall of the SSE) / (the fall expected without them: the richer model's "
+                     "residual variance &times; n / n<sub>eff</sub> per extra parameter, so that correlated points count as "
+                     "the independent points they are worth, plus what the voxels' edge offset field gives those "
+                     "parameters; its spread lowers the degrees of freedom) (n<sub>eff</sub>: the cap's points for errors shared over " +
                      fixed(numberAt(selection, "length_mm"), 1) +
                      " mm; 0 mm: from each fit's residuals). A model the points do not determine is never selected.</p>\n"
                      "<table id=\"selection-steps\"><tr><th>step</th><th>F</th><th>df</th><th>n<sub>eff</sub></th>"
@@ -220,7 +229,7 @@ std::string selectionTable(const json& results) {
     for (const auto& st : steps)
       html += "<tr class=\"" + kind + "\"><td>" + report::escapeMarkup(text(st, "simpler")) + " &rarr; " +
               report::escapeMarkup(text(st, "richer")) + (kind == "path" ? " (choice)" : "") + "</td><td>" +
-              fixed(numberAt(st, "f"), 2) + "</td><td>" + text(st, "df1") + ", " + text(st, "df2") + "</td><td>" +
+              fixed(numberAt(st, "f"), 2) + "</td><td>" + degreesOfFreedom(st) + ", " + text(st, "df2") + "</td><td>" +
               fixed(numberAt(st, "n_eff"), 0) + "</td><td>" + probability(numberAt(st, "p_value")) + "</td><td>" +
               fixed(numberAt(st, "alpha"), 4) + "</td><td>" + (member(st, "richer_needed") == true ? "yes" : "no") +
               "</td></tr>\n";

@@ -59,8 +59,26 @@ std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
 json stepJson(const statistics::NestedStep& s) {
   const auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   return {{"simpler", s.simpler}, {"richer", s.richer},   {"f", finite(s.f)},         {"df1", s.df1},
-          {"df2", s.df2},         {"n_eff", finite(s.n_eff)}, {"p_value", finite(s.p_value)}, {"alpha", finite(s.alpha)},
+          {"df1_effective", finite(s.df1_effective)}, {"df2", s.df2},         {"n_eff", finite(s.n_eff)}, {"p_value", finite(s.p_value)}, {"alpha", finite(s.alpha)},
           {"richer_needed", s.richer_needed}};
+}
+
+// fits.json's edge_offset_absorbed_terms_mm2: a square matrix, else empty
+// (an older or foreign fits.json; the selection then takes the field's sum
+// as carried by one term, the widest spread).
+Eigen::MatrixXd absorbedTerms(const json& fit_entry) {
+  const json terms = fit_entry.value("edge_offset_absorbed_terms_mm2", json::array());
+  const auto n = static_cast<Eigen::Index>(terms.is_array() ? terms.size() : 0);
+  Eigen::MatrixXd out(n, n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const json& row = terms[static_cast<size_t>(r)];
+    if (!row.is_array() || static_cast<Eigen::Index>(row.size()) != n) return {};
+    for (Eigen::Index c = 0; c < n; ++c) {
+      if (!row[static_cast<size_t>(c)].is_number()) return {};
+      out(r, c) = row[static_cast<size_t>(c)].get<double>();
+    }
+  }
+  return out;
 }
 
 json readStageJson(const fs::path& path) {
@@ -299,6 +317,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
     // An ovoid's c0x and c0y are its gauge (fits.json "gauge"), never listed as not identifiable.
     e.determined = statistics::determinedByPoints(shapes[i].model, m.value("not_identifiable", std::vector<std::string>{}));
     e.edge_offset_absorbed_mm2 = fit_entry.value("edge_offset_absorbed_mm2", 0.0);
+    e.edge_offset_absorbed_terms_mm2 = absorbedTerms(fit_entry);
     evidence.push_back(e);
   }
   const statistics::ModelSelection selection = statistics::selectNested(evidence, o.selection_alpha);
@@ -397,10 +416,13 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
       {"edge_offset_field", fits.value("edge_offset_field", json(nullptr))},
       {"selection",
        {{"rule",
-         "each model the points determine (not undetermined) is tested against every determined model containing it (F = ((SSE_simpler - SSE_richer - the edge offset field's part) / df1) / (SSE_richer / df2) x n_eff / n, df1 the "
-         "extra free parameters, "
-         "n_eff the points' effective number of independent points for errors correlated over length_mm; with "
-         "length_mm 0, the geometric mean of the two models' from their residuals) at alpha / their number; a model "
+         "each model the points determine (not undetermined) is tested against every determined model containing it "
+         "(F = (SSE_simpler - SSE_richer) / (s2 x df1 + mu) on (df1_effective, df2) degrees of freedom, "
+         "s2 = SSE_richer / df2 x n / n_eff, df1 the extra free parameters, df2 = n - the richer model's, mu the edge "
+         "offset field's expected part of the fall; df1_effective matches the variance of the noise's and the field's "
+         "parts (Satterthwaite; df1 without a field); n_eff the points' effective number of independent points for "
+         "errors correlated over length_mm; with length_mm 0, the geometric mean of the two models' from their "
+         "residuals) at alpha / their number; a model "
          "is supported when it is the simplest or needed over every supported model it contains; the selected model "
          "is the simplest supported one that no model containing it beats"},
         {"alpha", o.selection_alpha},

@@ -93,6 +93,12 @@ struct ParameterUncertainty {
   /// expected over the field (sum_k sd_k^2 f_k^T J (J^T J)^-1 J^T f_k, mm^2):
   /// what a richer model's gain over a simpler one may owe to the field.
   double edge_offset_absorbed_mm2 = 0;
+  /// The same per pair of the field's five terms (beta along x, y, z, gamma,
+  /// delta, each at unit standard deviation): A = F^T J (J^T J)^-1 J^T F,
+  /// whose trace is the above. A richer model's gain owed to the field is the
+  /// quadratic form c^T (A_richer - A_simpler) c over the terms' standard
+  /// normal weights c: of mean its trace and variance 2 ||.||_F^2 (empty: no field).
+  Eigen::MatrixXd edge_offset_absorbed_terms_mm2;
   std::vector<std::string> not_identifiable;  // parameter names: a near-singular J^T J or a very wide interval
   std::vector<std::string> gauge;           // held at their fitted values: an ovoid's c0x and c0y
   double condition_number = 0;              // of J^T J with unit-scaled columns, gauge held

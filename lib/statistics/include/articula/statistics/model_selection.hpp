@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "articula/fit/fit_hierarchy.hpp"
 #include "articula/geometry/shape.hpp"
 
@@ -34,20 +36,28 @@ double bic(double sse, int n, int k);
 /// sphere -> ellipsoid -> {superellipsoid, ovoid} -> superovoid that counts
 /// the points the residuals' spatial correlation leaves (fit/residual_correlation.hpp).
 ///
-/// The test of a simpler model against a richer one that contains it is the
+/// The test of a simpler model against a richer one that contains it is an
 /// F test of the fall of the sum of squared distances with an effective
 /// number of independent points n_eff, the geometric mean of the two
 /// models' ModelEvidence::n_eff (the report stage gives every model the
 /// points' n_eff at the selection's correlation length, subject_report.hpp;
 /// with length 0, each fit's own from its residuals, where the simpler
 /// model's count the richer model's gain as correlated noise and the richer
-/// model's have absorbed part of the noise):
-///   F = ((SSE_s - SSE_r) / (k_r - k_s)) / (SSE_r / (n - k_r)) x n_eff / n,
-/// on (k_r - k_s, n - k_r) degrees of freedom. A smooth error field (blur,
-/// partial volume, anisotropic voxels) projects onto a richer model's extra
-/// directions about n / n_eff times more than independent noise would; the
-/// denominator's variance comes from all the points. Without the factor
-/// (the plain F test, AIC, BIC) every small gain on a CT surface looks real.
+/// model's have absorbed part of the noise). Where the simpler model is
+/// right, the fall is the noise's share, s^2 chi^2(df1) with
+/// s^2 = SSE_r / (n - k_r) x n / n_eff (a smooth error field projects onto a
+/// richer model's extra directions about n / n_eff times more than
+/// independent noise would), plus the edge offset field's share, a quadratic
+/// form in its few terms' weights of mean mu and variance v (fit/uncertainty.hpp,
+/// edge_offset_absorbed_terms_mm2). Their sum is taken as a scaled chi^2 of the
+/// same mean and variance (Satterthwaite):
+///   F = fall / (s^2 df1 + mu) on (h, n - k_r) degrees of freedom,
+///   h = 2 (s^2 df1 + mu)^2 / (2 s^4 df1 + v),
+/// the plain F test with df1 = h where there is no field. Subtracting the
+/// field's mean alone (an earlier rule) took a field carried by one or two
+/// terms, which spreads as widely as chi^2(1), for a shape: spheres at
+/// 2.5-3 mm slices became ovoids. Without the factor n_eff / n (the plain F
+/// test, AIC, BIC) every small gain on a CT surface looks real.
 ///
 /// The choice: every determined model is tested against each determined
 /// model that contains it, at alpha / (their number) (Bonferroni). A model
@@ -73,11 +83,15 @@ struct ModelEvidence {
   double n_eff = NAN;  // NaN: taken as n_points (independent residuals)
   bool determined = true;
   double edge_offset_absorbed_mm2 = 0;  // fits.json's: the edge offset field's sum of squares the model takes up
+  // fits.json's, per pair of the field's terms (trace: the above). Empty: only
+  // the sum known, taken as carried by one term (the widest spread).
+  Eigen::MatrixXd edge_offset_absorbed_terms_mm2{};
 };
 struct NestedStep {
   std::string simpler, richer;
   double f = NAN;          // the statistic above
-  int df1 = 0, df2 = 0;
+  int df1 = 0, df2 = 0;    // the richer model's extra free parameters; n - k_r
+  double df1_effective = NAN;  // h above: df1 without an edge offset field
   double n_eff = NAN;      // as used: the geometric mean of the two models'
   double p_value = NAN;    // P(F(df1, df2) >= f)
   double alpha = NAN;      // the level it was judged at
