@@ -49,12 +49,8 @@ test ! -e "$T/l.nii.gz" || { echo "FAIL: a label was written for a damaged serie
 edit="python3 $(dirname "$0")/dicom_edit.py"
 slices() { rm -rf "$T/s" && cp -r "$T/p/dicom" "$T/s"; }
 slices
-for i in $(seq 20 40); do  # a block of slices shifted 20.3 mm in x
-  f=$T/s/slice_00$i.dcm
-  pos=$(python3 -c "import sys; sys.path.insert(0, '$(dirname "$0")'); import dicom_edit as d; print(d.value('$f', '0020,0032'))")
-  IFS='\\' read -r x y z <<< "$pos"
-  $edit "$f" "$f" "0020,0032=$(python3 -c "print(f'{$x + 20.3:.7g}')")\\$y\\$z"
-done
+# A block of slices shifted 20.3 mm in x.
+$edit $(for i in $(seq 20 40); do echo "$T/s/slice_00$i.dcm $T/s/slice_00$i.dcm"; done) -- 0020,0032=shift:20.3,0,0
 expect 3 "slice_0020.dcm (slice 21 of 64) lies 20.3 mm beside the line from the first slice to the last" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
 slices && $edit "$T/p/dicom/slice_0030.dcm" "$T/s/slice_0030.dcm" 7FE0,0010=cut:7000
@@ -63,10 +59,10 @@ expect 3 "slice_0030.dcm (slice 31 of 64) holds 7000 bytes of pixel data, its he
 slices && $edit "$T/p/dicom/slice_0030.dcm" "$T/s/slice_0030.dcm" 0028,0010=us:30000 0028,0011=us:30000
 expect 3 "slice_0030.dcm (slice 31 of 64) is 30000 x 30000 pixels (rows x columns), the first slice 75 x 95" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
-slices && for f in "$T/p/dicom/"*.dcm; do $edit "$f" "$T/s/$(basename "$f")" 0028,0010=us:30000 0028,0011=us:30000; done
+slices && $edit $(for f in "$T/p/dicom/"*.dcm; do echo "$f $T/s/$(basename "$f")"; done) -- 0028,0010=us:30000 0028,0011=us:30000
 expect 3 "holds 14250 bytes of pixel data, its header announces 30000 x 30000 pixels" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
-slices && for i in $(seq 32 63); do $edit "$T/p/dicom/slice_00$i.dcm" "$T/s/slice_00$i.dcm" '0028,0030=1.4\1.4'; done
+slices && $edit $(for i in $(seq 32 63); do echo "$T/p/dicom/slice_00$i.dcm $T/s/slice_00$i.dcm"; done) -- '0028,0030=1.4\1.4'
 expect 3 "slice_0032.dcm (slice 33 of 64) has Pixel Spacing (1.4, 1.4) mm, the first slice (1.5, 1.5)" -- \
   "$B/articula-segment" -i "$T/s" -o "$T/l.nii.gz"
 slices && $edit "$T/p/dicom/slice_0030.dcm" "$T/s/slice_0030.dcm" 0028,1053=0

@@ -3,9 +3,12 @@
 hostile file would have them (the tests' probes; pydicom is not a dependency).
 
     dicom_edit.py IN OUT TAG=VALUE ...
+    dicom_edit.py IN OUT [IN OUT ...] -- TAG=VALUE ...   (the same edits on many files)
 
 TAG is "gggg,eeee". VALUE is text for string elements (DS, IS, ...), "us:N"
-for a 16-bit number (Rows, Columns, ...), "cut:N" to keep only the first N
+for a 16-bit number (Rows, Columns, ...), "shift:D1,D2,..." to add D1, D2, ...
+to a multi-valued decimal string's values (0 leaves one as it is),
+"cut:N" to keep only the first N
 bytes of the element's value (its length then says N: a slice whose pixel data
 is short of what its Rows x Columns announce), or "drop" to remove it. A text
 or number for an element the file lacks inserts it in its place.
@@ -43,18 +46,18 @@ def meta_end(data):
     return end
 
 
-def value(path, tag):
-    """The text of a top-level element, e.g. value(f, "0020,0032")."""
-    data = open(path, "rb").read()
-    want = tuple(int(x, 16) for x in tag.split(","))
-    for found, pos, head, length, _ in elements(data, meta_end(data), False):
-        if found == want:
-            return data[pos + head:pos + head + length].decode().rstrip(" \0")
-    raise SystemExit(f"dicom_edit.py: {path} has no element {tag}")
-
-
 def main():
-    source, target, *edits = sys.argv[1:]
+    # One process for many files: a test's loop over slices otherwise
+    # spends most of its time starting Python.
+    args = sys.argv[1:]
+    files, edits = (args[:args.index("--")], args[args.index("--") + 1:]) if "--" in args else (args[:2], args[2:])
+    if len(files) < 2 or len(files) % 2:
+        raise SystemExit("dicom_edit.py: expected IN OUT pairs, found " + " ".join(files))
+    for source, target in zip(files[::2], files[1::2]):
+        edit_file(source, target, edits)
+
+
+def edit_file(source, target, edits):
     data = bytearray(open(source, "rb").read())
     assert data[128:132] == b"DICM", source
     end = meta_end(data)
@@ -73,6 +76,12 @@ def main():
             return struct.pack("<H", int(edit[3:]))
         if edit.startswith("cut:"):
             return value[:int(edit[4:])]
+        if edit.startswith("shift:"):
+            parts = value.decode().rstrip(" \0").split("\\")
+            shifts = [float(d) for d in edit[6:].split(",")]
+            if len(shifts) != len(parts):
+                raise SystemExit(f"dicom_edit.py: {edit} for {len(parts)} values")
+            edit = "\\".join(f"{float(p) + d:.7g}" if d else p for p, d in zip(parts, shifts))
         value = edit.encode()
         return value + b" " if len(value) % 2 else value
 
