@@ -65,18 +65,38 @@ def matrix(quick, fresh=False):
     return cts
 
 
+# The models each model contains (itself aside).
+CONTAINED = {"sphere": set(), "ellipsoid": {"sphere"}, "superellipsoid": {"sphere", "ellipsoid"},
+             "ovoid": {"sphere", "ellipsoid"}, "superovoid": {"sphere", "ellipsoid", "superellipsoid", "ovoid"}}
+
+
 def shape_model(bin_dir, exact_points, fits_json):
     """The simplest model whose fit to the true surface's points at the run's
     points (exact data) lies within SAME_SHAPE_MM RMS: the model the truth
-    is to any data (a drawn ellipsoid of radii within 0.1 % is a sphere)."""
+    is to any data (a drawn ellipsoid of radii within 0.1 % is a sphere);
+    and how far the truth departs from every model that does not contain
+    that one (the least RMS of their exact fits, mm; None for a sphere):
+    what the data must resolve for the selection to tell it."""
     subprocess.run([f"{bin_dir}/articula", "fit", "-i", exact_points, "-o", fits_json, "--force", "-q", "--threads", "1"],
                    check=True)
     fits = json.load(open(fits_json))
-    for m in MODELS:
-        f = next(f for f in fits["models"] if f["model"] == m)
-        if (f["geometric_objective_mm2"] / fits["n_points"]) ** 0.5 <= SAME_SHAPE_MM:
-            return m
-    return MODELS[-1]
+    rms = {f["model"]: (f["geometric_objective_mm2"] / fits["n_points"]) ** 0.5 for f in fits["models"]}
+    model = next((m for m in MODELS if rms[m] <= SAME_SHAPE_MM), MODELS[-1])
+    others = [rms[m] for m in MODELS if m != model and model not in CONTAINED[m]]
+    return model, min(others) if others else None
+
+
+def resolvable(rows):
+    """The selection on heads whose true shape departs from every model not
+    containing it by at least the points' own error (RMS to the true
+    surface), and on the rest."""
+    done = [r for r in rows if r["exit"] == 0 and r.get("departure_mm") is not None]
+    parts = []
+    for name, group in (("departing by at least the points' RMS error", [r for r in done if r["departure_mm"] >= r["rms_mm"]]),
+                        ("by less", [r for r in done if r["departure_mm"] < r["rms_mm"]])):
+        right = sum(r.get("selected") == r.get("shape_model") for r in group)
+        parts.append(f"{name}: {right} of {len(group)} right")
+    return "Heads other than spheres, " + "; ".join(parts) + "."
 
 
 def run_ct(ct, bin_dir, work, run_args=()):
@@ -112,7 +132,7 @@ def run_ct(ct, bin_dir, work, run_args=()):
                                 f"{out}/results.json"], check=True, capture_output=True, text=True,
                                env=dict(os.environ, ARTICULA_SCORE_TRUE_POINTS=exact))
             row.update(json.loads(s.stdout))
-            row["shape_model"] = shape_model(bin_dir, exact, f"{d}/true-fits-{side}.json")
+            row["shape_model"], row["departure_mm"] = shape_model(bin_dir, exact, f"{d}/true-fits-{side}.json")
             results = json.load(open(f"{out}/results.json"))
             row["selected"] = results.get("selected_model")
             row["qc"] = results.get("qc", {}).get("status", "")
@@ -206,7 +226,7 @@ def main():
     json.dump(rows, open(os.path.join(args.work, "robustness.json"), "w"), indent=1)
     text = (table(rows) + "\n\nSelected model against the true model:\n\n" + confusion(rows) +
             f"\n\nAgainst the simplest model the true surface is (its exact points within {SAME_SHAPE_MM} mm RMS):\n\n" +
-            confusion(rows, "shape_model"))
+            confusion(rows, "shape_model") + "\n\n" + resolvable(rows))
     open(os.path.join(args.work, "robustness.md"), "w").write(text + "\n")
     print(text)
     print(f"\n{len(rows)} heads from {len(cts)} CTs in {time.time() - t0:.0f} s wall with -j {args.j}", file=sys.stderr)
