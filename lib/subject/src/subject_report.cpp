@@ -58,8 +58,15 @@ std::string withUnit(const std::string& name, geometry::ParameterKind kind) {
 
 json stepJson(const statistics::NestedStep& s) {
   const auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  return {{"simpler", s.simpler}, {"richer", s.richer},   {"f", finite(s.f)},         {"df1", s.df1},
-          {"df1_effective", finite(s.df1_effective)}, {"df2", s.df2},         {"n_eff", finite(s.n_eff)}, {"p_value", finite(s.p_value)}, {"alpha", finite(s.alpha)},
+  return {{"simpler", s.simpler},
+          {"richer", s.richer},
+          {"f", finite(s.f)},
+          {"df1", s.df1},
+          {"df1_effective", finite(s.df1_effective)},
+          {"df2", s.df2},
+          {"n_eff", finite(s.n_eff)},
+          {"p_value", finite(s.p_value)},
+          {"alpha", finite(s.alpha)},
           {"richer_needed", s.richer_needed}};
 }
 

@@ -93,7 +93,7 @@ struct NestedStep {
   int df1 = 0, df2 = 0;    // the richer model's extra free parameters; n - k_r
   double df1_effective = NAN;  // h above: df1 without an edge offset field
   double n_eff = NAN;      // as used: the geometric mean of the two models'
-  double p_value = NAN;    // P(F(df1, df2) >= f)
+  double p_value = NAN;    // P(F(df1_effective, df2) >= f)
   double alpha = NAN;      // the level it was judged at
   bool richer_needed = false;  // p_value < alpha
 };
