@@ -4,10 +4,10 @@
 # NIfTI, the right humeral head of the thorax DICOM series and the complete
 # left humeral head of the lossy JPEG 2000 breast-RT series. The articular
 # sphere must be that of an adult joint head (18-30 mm), on the asked side,
-# and agree with the search's own sphere. The thorax's heads through the
-# whole run fail their checks, each for its reason; the 3 mm hip's left head
-# is found beside its screws, the metal named. The abdomen series holds
-# no joint head: exit code 1.
+# and agree with the search's own sphere. The 3 mm hip's left head is
+# found beside its screws, the metal named. The abdomen series holds no
+# joint head: exit code 1. (The thorax's heads through the whole run:
+# ct_real_thorax.sh.)
 # labels: full-size
 set -euo pipefail
 D=${ARTICULA_SHARED_DATA:-}
@@ -36,36 +36,6 @@ PY
 }
 run hip "$D/ct/hip-3mm-nifti/example_ct.nii.gz" hip right
 run shoulder "$D/ct/thorax-shoulders-dicom" shoulder right
-# The thorax's humeral heads through the whole run: the right one's top
-# lies above the field of view (the report names the clipped head, a fail);
-# on the left the search takes a vertebra, on the body's midline (a fail).
-for side in right left; do
-  set +e
-  "$B/articula" run -i "$D/ct/thorax-shoulders-dicom" -o "$T/thorax-$side" --joint shoulder --side "$side" -q 2> "$T/thorax-$side.err"
-  set -e
-  python3 - "$T/thorax-$side/results.json" "$side" <<'PY'
-import json, sys
-import re
-results, side = json.load(open(sys.argv[1])), sys.argv[2]
-qc = results["qc"]
-# The selected model's radii the points do not determine carry no interval on the page.
-model = next(m for m in results["models"] if m["model"] == results["selected_model"])
-open_radii = [r for r in ("a", "b", "c") if r in model["not_identifiable"]]
-cell = re.search(r'<td id="(?:radii|semi-axes)">(.*?)</td>', open(sys.argv[1].replace("results.json", "report.html")).read()).group(1)
-assert cell.count("not determined") == len(open_radii), (open_radii, cell)
-# A model the points leave open is never selected.
-assert results["selected_model"] not in results["selection"]["undetermined"], results["selection"]
-checks = {c["name"]: c for c in qc["checks"]}
-print(f"thorax {side}: qc {qc['status']}: " + "; ".join(qc.get("reasons", [])))
-assert qc["status"] == "fail", qc["status"]
-if side == "right":
-    assert checks["head_outside_volume_share"]["status"] == "fail", checks["head_outside_volume_share"]
-    assert checks["head_from_body_middle_mm"]["status"] == "pass", checks["head_from_body_middle_mm"]
-else:
-    assert checks["head_from_body_middle_mm"]["status"] == "fail", checks["head_from_body_middle_mm"]
-PY
-done
-grep -q "field of view clips the head" "$T/thorax-right.err" || fail "thorax right: the clipped head is not named: $(cat "$T/thorax-right.err")"
 # The 3 mm hip's left femur carries screws: the head is found, the metal named.
 set +e
 "$B/articula" run -i "$D/ct/hip-3mm-nifti/example_ct.nii.gz" -o "$T/hip-left" --joint hip --side left -q 2> "$T/hip-left.err"
