@@ -141,6 +141,21 @@ geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::
   return p;
 }
 
+Eigen::MatrixXd absorbedTermsFromJson(const nlohmann::json& entry) {
+  const nlohmann::json terms = entry.value("edge_offset_absorbed_terms_mm2", nlohmann::json::array());
+  const auto n = static_cast<Eigen::Index>(terms.is_array() ? terms.size() : 0);
+  Eigen::MatrixXd out(n, n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const nlohmann::json& row = terms[static_cast<size_t>(r)];
+    if (!row.is_array() || static_cast<Eigen::Index>(row.size()) != n) return {};
+    for (Eigen::Index c = 0; c < n; ++c) {
+      if (!row[static_cast<size_t>(c)].is_number()) return {};
+      out(r, c) = row[static_cast<size_t>(c)].get<double>();
+    }
+  }
+  return out;
+}
+
 std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where) {
   if (!document.is_object() || !document.contains("models") || !document.at("models").is_array() ||
       document.at("models").empty())

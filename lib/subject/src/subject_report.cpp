@@ -70,24 +70,6 @@ json stepJson(const statistics::NestedStep& s) {
           {"richer_needed", s.richer_needed}};
 }
 
-// fits.json's edge_offset_absorbed_terms_mm2: a square matrix, else empty
-// (an older or foreign fits.json; the selection then takes the field's sum
-// as carried by one term, the widest spread).
-Eigen::MatrixXd absorbedTerms(const json& fit_entry) {
-  const json terms = fit_entry.value("edge_offset_absorbed_terms_mm2", json::array());
-  const auto n = static_cast<Eigen::Index>(terms.is_array() ? terms.size() : 0);
-  Eigen::MatrixXd out(n, n);
-  for (Eigen::Index r = 0; r < n; ++r) {
-    const json& row = terms[static_cast<size_t>(r)];
-    if (!row.is_array() || static_cast<Eigen::Index>(row.size()) != n) return {};
-    for (Eigen::Index c = 0; c < n; ++c) {
-      if (!row[static_cast<size_t>(c)].is_number()) return {};
-      out(r, c) = row[static_cast<size_t>(c)].get<double>();
-    }
-  }
-  return out;
-}
-
 json readStageJson(const fs::path& path) {
   if (!fs::exists(path))
     throw InputError("the report needs '" + path.string() + "', which is missing: run the earlier stages first");
@@ -324,7 +306,7 @@ checks::QcReport writeSubjectReport(const SubjectReportOptions& o) {
     // An ovoid's c0x and c0y are its gauge (fits.json "gauge"), never listed as not identifiable.
     e.determined = statistics::determinedByPoints(shapes[i].model, m.value("not_identifiable", std::vector<std::string>{}));
     e.edge_offset_absorbed_mm2 = fit_entry.value("edge_offset_absorbed_mm2", 0.0);
-    e.edge_offset_absorbed_terms_mm2 = absorbedTerms(fit_entry);
+    e.edge_offset_absorbed_terms_mm2 = fit::absorbedTermsFromJson(fit_entry);
     evidence.push_back(e);
   }
   const statistics::ModelSelection selection = statistics::selectNested(evidence, o.selection_alpha);

@@ -26,6 +26,11 @@ nlohmann::json fitsDocument(const Summary& summary, const std::string& input, co
 /// missing or malformed key and `where` (e.g. the file name and index).
 geometry::ShapeParameters shapeFromJson(const nlohmann::json& entry, const std::string& where);
 
+/// A "models" entry's edge_offset_absorbed_terms_mm2 (a square matrix), else
+/// empty: an older or foreign fits.json, whose selection then takes the
+/// field's sum as carried by one term (statistics/model_selection.hpp).
+Eigen::MatrixXd absorbedTermsFromJson(const nlohmann::json& entry);
+
 /// Every shape of a fits.json document, in file order.
 std::vector<geometry::ShapeParameters> shapesFromFitsJson(const nlohmann::json& document, const std::string& where);
 
