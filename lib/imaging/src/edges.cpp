@@ -15,6 +15,30 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRelativeStrength = 0.25;
 constexpr double kContrastReachMm = 1.5;  // the fall is measured within this distance either side
 
+/// HU at a continuous index by trilinear interpolation; NaN outside the grid.
+double interpolateAtIndex(const Volume& volume, const Eigen::Vector3d& idx) {
+  const ImageGeometry& g = volume.geometry;
+  Eigen::Vector3i base;
+  Eigen::Vector3d frac;
+  for (int a = 0; a < 3; ++a) {
+    if (!(idx[a] >= 0 && idx[a] <= g.size[a] - 1)) return kNaN;
+    base[a] = std::min(static_cast<int>(std::floor(idx[a])), std::max(g.size[a] - 2, 0));
+    frac[a] = idx[a] - base[a];
+  }
+  double value = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    double weight = 1;
+    Eigen::Vector3i v = base;
+    for (int a = 0; a < 3; ++a) {
+      const bool up = corner >> a & 1;
+      weight *= up ? frac[a] : 1 - frac[a];
+      if (up) v[a] = std::min(v[a] + 1, g.size[a] - 1);
+    }
+    if (weight != 0) value += weight * volume.at(v[0], v[1], v[2]);
+  }
+  return value;
+}
+
 /// The profile I(t0 + n step), smoothed by a Gaussian of sigma_mm, and its derivative.
 struct Profile {
   double t0 = 0, step = 0.1;
@@ -31,8 +55,12 @@ Profile sampleProfile(const Volume& volume, const Eigen::Vector3d& x, const Eige
   p.step = search.step_mm;
   const auto count = static_cast<size_t>(std::floor((to - from) / p.step)) + 1;
   std::vector<double> raw(count);
+  // The line in index space once, not the direction's inverse per sample.
+  const ImageGeometry& g = volume.geometry;
+  const Eigen::Vector3d start = g.toIndex(x + p.t0 * u);
+  const Eigen::Vector3d stride = g.toIndex(x + (p.t0 + p.step) * u) - start;
   for (size_t n = 0; n < count; ++n) {
-    raw[n] = interpolate(volume, x + p.t(n) * u);
+    raw[n] = interpolateAtIndex(volume, start + static_cast<double>(n) * stride);
     if (std::isnan(raw[n])) {
       p.complete = false;
       raw.resize(n);
@@ -89,27 +117,7 @@ bool isFallingMinimum(const Profile& p, size_t n) {
 }  // namespace
 
 double interpolate(const Volume& volume, const Eigen::Vector3d& x) {
-  const ImageGeometry& g = volume.geometry;
-  const Eigen::Vector3d idx = g.toIndex(x);
-  Eigen::Vector3i base;
-  Eigen::Vector3d frac;
-  for (int a = 0; a < 3; ++a) {
-    if (!(idx[a] >= 0 && idx[a] <= g.size[a] - 1)) return kNaN;
-    base[a] = std::min(static_cast<int>(std::floor(idx[a])), std::max(g.size[a] - 2, 0));
-    frac[a] = idx[a] - base[a];
-  }
-  double value = 0;
-  for (int corner = 0; corner < 8; ++corner) {
-    double weight = 1;
-    Eigen::Vector3i v = base;
-    for (int a = 0; a < 3; ++a) {
-      const bool up = corner >> a & 1;
-      weight *= up ? frac[a] : 1 - frac[a];
-      if (up) v[a] = std::min(v[a] + 1, g.size[a] - 1);
-    }
-    if (weight != 0) value += weight * volume.at(v[0], v[1], v[2]);
-  }
-  return value;
+  return interpolateAtIndex(volume, volume.geometry.toIndex(x));
 }
 
 Edge locateEdge(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& outward,
