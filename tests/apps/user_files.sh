@@ -28,13 +28,13 @@ grep -q "refusing to overwrite .*truth.json" "$tmp/err" || fail "phantom: truth.
 [ "$(cat "$p/truth.json")" = '{"mine": true}' ] || fail "phantom replaced truth.json without --force"
 [ ! -e "$p/phantom.nii.gz" ] || fail "phantom wrote before refusing"
 # Its own earlier series is replaced with --force, slice for slice.
-expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.2,1.2,3 -q --force
+expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.5,1.5,4 -q --force
 slices=$(find "$p/dicom" -name 'slice_*.dcm' | wc -l)
-expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.2,1.2,1.5 -q --force
+expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.5,1.5,2 -q --force
 [ "$(find "$p/dicom" -type f | wc -l)" -gt "$slices" ] || fail "the thinner slices' series: $(find "$p/dicom" -type f | wc -l) files"
-expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.2,1.2,3 -q --force
+expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.5,1.5,4 -q --force
 [ "$(find "$p/dicom" -type f | wc -l)" -eq "$slices" ] || fail "the thicker slices' series kept the earlier slices"
-expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.2,1.2,1.5 -q --force
+expect_rc 0 "$bin/articula" phantom -o "$p" --spacing 1.5,1.5,2 -q --force
 echo "x" > "$tmp/a-file"
 expect_rc 2 "$bin/articula" phantom -o "$tmp/a-file" -q
 grep -q "is a file: expected a folder" "$tmp/err" || fail "phantom -o FILE: $(cat "$tmp/err")"
