@@ -45,8 +45,12 @@ def as_text(value):
         return str(int(value))
     return str(value)
 
-count = 0
+# Every option at once: each stage's command takes all of its own, and one
+# dry run takes every stage's (a process each, not two per option: under the
+# sanitizers a start costs most of a second).
+count, run_given, checks = 0, [], []
 for stage in stages:
+    given_all = []
     for o in stage["options"]:
         name, run_name, kind = o["name"], o["run_name"], o["type"]
         assert kind in ("number", "integer", "flag", "text", "file", "choice", "numbers", "choices"), o
@@ -54,25 +58,32 @@ for stage in stages:
         value = examples.get(name) if o["default"] in ("", []) else as_text(o["default"])
         assert value is not None, f"no value to try for {stage['name']} --{name}"
         given = [f"--{name}"] if kind == "flag" else [f"--{name}", value]
-        # The stage's own command.
-        r = articula(stage["name"], *wiring(stage), *given)
-        assert r.returncode == 3, (stage["name"], given, r.returncode, r.stderr)
-        # run, under its run name: the stage gets it, under its own.
-        run_given = [f"--{run_name}"] if kind == "flag" else [f"--{run_name}", value]
-        r = articula("run", "-i", ct, "-o", f"{tmp}/dry", "--dry-run", "--json", *run_given)
-        assert r.returncode == 0, (run_given, r.stderr)
-        plan = {s["stage"]: s["arguments"] for s in json.loads(r.stdout)["stages"]}
-        args = plan[stage["name"]]
-        assert given[0] in args and (kind == "flag" or args[args.index(given[0]) + 1] == value), (given, args)
-        for other, other_args in plan.items():  # only the stages that take it under that run name
-            takes = any(x["run_name"] == run_name for s in stages if s["name"] == other for x in s["options"])
-            assert takes or not any(a == given[0] for a in other_args[::2]) or other == stage["name"], (other, given)
+        given_all += given
+        if run_name not in [g[2:] for g in run_given if g.startswith("--")]:
+            run_given += [f"--{run_name}"] if kind == "flag" else [f"--{run_name}", value]
+        checks.append((stage["name"], run_name, kind, given))
         # run --help: the option, with its default where it has one.
         line = re.search(r"^\s*--%s(?: [A-Z]+(?: x \d+)?)?(?:=(\S+))?\s" % re.escape(run_name), help_text, re.M)
         assert line, f"run --help does not list --{run_name}"
         if kind != "flag" and o["default"] not in ("", []):
             assert line.group(1) == as_text(o["default"]), (run_name, line.group(0))
         count += 1
+    # The stage's own command: the line parses, then the missing input stops it.
+    r = articula(stage["name"], *wiring(stage), *given_all)
+    assert r.returncode == 3, (stage["name"], given_all, r.returncode, r.stderr)
+# run, under the run names: each stage gets its options, under its own names,
+# and no stage gets an option that is not its own.
+r = articula("run", "-i", ct, "-o", f"{tmp}/dry", "--dry-run", "--json", *run_given)
+assert r.returncode == 0, (run_given, r.stderr)
+plan = {s["stage"]: s["arguments"] for s in json.loads(r.stdout)["stages"]}
+for stage_name, run_name, kind, given in checks:
+    args = plan[stage_name]
+    assert given[0] in args and (kind == "flag" or args[args.index(given[0]) + 1] == given[1]), (given, args)
+for stage in stages:
+    common = {"--seed", "--threads", "--force", "--quiet", "--verbose"}  # every command's
+    own = {f"--{o['name']}" for o in stage["options"]} | {a for a in stage["arguments"] if a.startswith("-")} | common
+    strays = [a for a in plan[stage["name"]] if a.startswith("--") and a not in own]
+    assert not strays, (stage["name"], strays)
 assert not os.path.exists(f"{tmp}/dry"), "a dry run wrote"
 print(f"{count} stage options: taken by their stages and by run, listed in run --help")
 assert count >= 44, count
