@@ -30,7 +30,7 @@ PY
 # The driver without the stage knows nothing of it.
 expect_rc 2 "$bin/articula" run -i x -o "$tmp/none" --radii-scale 2
 
-"$bin/articula" phantom -o "$tmp/p" --seed 4 --model ellipsoid --spacing 1.2,1.2,1.5 --no-dicom --quiet
+"$bin/articula" phantom -o "$tmp/p" --seed 4 --model ellipsoid --spacing 1.5,1.5,2 --no-dicom --quiet
 "$articula" run -i "$tmp/p/phantom.nii.gz" -o "$tmp/run" --edge-model steepest --models sphere --radii-scale 2 --quiet
 # Each model's semi-axes in fits.json, times the factor.
 check_radii() {

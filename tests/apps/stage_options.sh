@@ -9,7 +9,7 @@
 # size) on a small phantom: each stage records the value it was given.
 source "$(dirname "$0")/common.bash"
 
-"$bin/articula" phantom -o "$tmp/p" --seed 3 --spacing 1.2,1.2,1.5 --no-dicom --quiet
+"$bin/articula" phantom -o "$tmp/p" --seed 3 --spacing 1.5,1.5,2 --no-dicom --quiet
 ct="$tmp/p/phantom.nii.gz"
 "$bin/articula" stages --json > "$tmp/stages.json"
 "$bin/articula" run --help > "$tmp/run-help.txt"
