@@ -29,11 +29,13 @@ check_console() {
   fi
 }
 
-"$bin/articula" phantom -o "$tmp/data/p1" --seed 4 --model ovoid --side left --no-dicom --quiet
+# The demo's full-size run, and a study of a small phantom (its edges on the
+# steepest fall: a quarter of the time) with a missing subject.
+"$bin/articula" phantom -o "$tmp/data/p1" --seed 4 --model ovoid --side left --spacing 1.2,1.2,1.5 --no-dicom --quiet
 cat > "$tmp/study.csv" <<CSV
-subject,input,joint,side
-p1,data/p1/phantom.nii.gz,hip,left
-missing,data/nowhere.nii.gz,hip,right
+subject,input,joint,side,edge_model
+p1,data/p1/phantom.nii.gz,hip,left,steepest
+missing,data/nowhere.nii.gz,hip,right,steepest
 CSV
 set +e
 "$bin/articula" batch "$tmp/study.csv" -o "$tmp/study" --quiet 2> /dev/null
