@@ -35,6 +35,7 @@ fs::path selfExecutable() {
 class BatchCommand : public cli::Command {
  public:
   std::string name() const override { return "batch"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Run the pipeline on every subject of a manifest (subject,input,joint,side[,options...]) and "
            "write study tables";

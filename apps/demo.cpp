@@ -32,6 +32,7 @@ Eigen::Vector3d vec(const json& j) { return {j.at(0).get<double>(), j.at(1).get<
 class DemoCommand : public cli::Command {
  public:
   std::string name() const override { return "demo"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Make a synthetic hip CT with a femoral head of known shape, run the pipeline on it, compare with the truth";
   }

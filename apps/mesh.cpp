@@ -17,6 +17,7 @@ namespace {
 class MeshCommand : public cli::Command {
  public:
   std::string name() const override { return "mesh"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Mesh a label image (flying edges, Laplacian smoothing, largest surface, normals) in LPS mm";
   }

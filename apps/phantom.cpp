@@ -20,6 +20,7 @@ namespace {
 class PhantomCommand : public cli::Command {
  public:
   std::string name() const override { return "phantom"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Write a synthetic hip CT (NIfTI + DICOM series) with a femoral head of known shape (or both hips), and truth.json";
   }

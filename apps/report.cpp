@@ -15,6 +15,7 @@ namespace {
 class ReportCommand : public cli::Command {
  public:
   std::string name() const override { return "report"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Write a subject's results, selected model and head checks from its stage outputs";
   }

@@ -43,6 +43,7 @@ std::string number(double v) {
 class RunCommand : public cli::Command {
  public:
   std::string name() const override { return "run"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Run segment -> mesh -> sample -> fit -> errors -> report on one CT, skipping stages that are up to date";
   }

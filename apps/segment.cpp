@@ -21,6 +21,7 @@ nlohmann::json vec(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 class SegmentCommand : public cli::Command {
  public:
   std::string name() const override { return "segment"; }
+  bool holdsVolumes() const override { return true; }
   std::string description() const override {
     return "Segment a femoral or humeral head from CT (DICOM folder, NIfTI, NRRD, MHA) into a uint8 label";
   }

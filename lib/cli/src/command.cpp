@@ -13,6 +13,7 @@
 #include "articula/core/parallel.hpp"
 #include "articula/core/provenance.hpp"
 #include "articula/core/version.hpp"
+#include "huge_pages.hpp"
 
 namespace articula::cli {
 
@@ -142,6 +143,7 @@ int runSingle(int argc, char** argv, const std::string& program, std::unique_ptr
 }  // namespace
 
 int runCommandMain(int argc, char** argv, std::unique_ptr<Command> command) {
+  if (command->holdsVolumes()) restartWithHugePages(argv);
   setCommandLine(argc, argv);
   const std::string program = "articula-" + command->name();
   return runSingle(argc, argv, program, std::move(command));
@@ -153,8 +155,10 @@ int runDriverMain(int argc, char** argv, std::vector<std::unique_ptr<Command>> c
   // (CLI11 reads --config files on the root app only, so each command gets its own).
   if (argc >= 2) {
     for (auto& command : commands)
-      if (command->name() == argv[1])
+      if (command->name() == argv[1]) {
+        if (command->holdsVolumes()) restartWithHugePages(argv);
         return runSingle(argc - 1, argv + 1, std::string("articula ") + argv[1], std::move(command));
+      }
     // A first word that is no option and no command: say so, whatever follows
     // (`articula nosuch --help` must not print the top-level help with exit 0).
     if (argv[1][0] != '-') {

@@ -2,6 +2,7 @@
 
 #include <openssl/evp.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 
@@ -86,6 +87,8 @@ nlohmann::json provenanceJson(const Provenance& p) {
                       {"units", "mm"}};
   if (p.seed >= 0) j["seed"] = p.seed;
   if (!g_invoking_command.empty()) j["invoked_by"] = g_invoking_command;
+  // How the process's memory was set up (huge pages: lib/cli/src/huge_pages.hpp).
+  if (const char* tunables = std::getenv("GLIBC_TUNABLES")) j["glibc_tunables"] = tunables;
   return j;
 }
 

@@ -48,6 +48,9 @@ class Command {
   /// (empty: nothing); argumentProblem() asks it, so that a caller can refuse
   /// a command line before any work.
   virtual std::string argumentsProblem(const CommonOptions&) const { return ""; }
+  /// Whether the command holds CT-sized volumes in memory: its process then
+  /// asks for transparent huge pages (lib/cli/src/huge_pages.hpp).
+  virtual bool holdsVolumes() const { return false; }
 };
 
 /// Registry of commands (PDAL-style): each apps/<name>.cpp registers its

@@ -32,7 +32,8 @@ struct Provenance {
 };
 
 /// {"articula_version", "git_commit", "command", ["invoked_by",] "seed", "parameters",
-///  "inputs": [{"path","sha256"}], "threads", "coordinate_system": "LPS", "units": "mm"}
+///  "inputs": [{"path","sha256"}], "threads", ["glibc_tunables",] "coordinate_system": "LPS",
+///  "units": "mm"}
 nlohmann::json provenanceJson(const Provenance& p);
 
 }  // namespace articula
