@@ -33,13 +33,7 @@ fi
 [ "$declined" = "glibc.malloc.hugetlb=0" ] || fail "the user's choice on huge pages: $declined"
 
 # fit holds no volume: no restart, no tunable.
-printf 'x,y,z\n' > "$tmp/points.csv"
-python3 -c '
-import math, sys
-with open(sys.argv[1], "a") as f:
-    for i in range(400):
-        z = 1 - 2 * (i + 0.5) / 400; r = math.sqrt(1 - z * z); a = i * 2.39996
-        f.write(f"{20 * r * math.cos(a)},{20 * r * math.sin(a)},{20 * z}\n")' "$tmp/points.csv"
-env -u GLIBC_TUNABLES "$bin/articula" fit -i "$tmp/points.csv" -o "$tmp/fits.json" --models sphere --quiet
+"$bin/articula" surface --model sphere -o "$tmp/sphere.ply" --quiet
+env -u GLIBC_TUNABLES "$bin/articula" fit -i "$tmp/sphere.ply" -o "$tmp/fits.json" --models sphere --quiet
 python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["provenance"]; assert "glibc_tunables" not in p, p' "$tmp/fits.json"
 echo "huge pages: ok"

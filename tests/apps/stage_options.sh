@@ -48,7 +48,7 @@ def as_text(value):
 # Every option at once: each stage's command takes all of its own, and one
 # dry run takes every stage's (a process each, not two per option: under the
 # sanitizers a start costs most of a second).
-count, run_given, checks = 0, [], []
+count, run_given, run_names, checks = 0, [], set(), []
 for stage in stages:
     given_all = []
     for o in stage["options"]:
@@ -59,7 +59,8 @@ for stage in stages:
         assert value is not None, f"no value to try for {stage['name']} --{name}"
         given = [f"--{name}"] if kind == "flag" else [f"--{name}", value]
         given_all += given
-        if run_name not in [g[2:] for g in run_given if g.startswith("--")]:
+        if run_name not in run_names:
+            run_names.add(run_name)
             run_given += [f"--{run_name}"] if kind == "flag" else [f"--{run_name}", value]
         checks.append((stage["name"], run_name, kind, given))
         # run --help: the option, with its default where it has one.
