@@ -25,7 +25,8 @@ assert radii["inputs"] == ["fits.json"] and radii["outputs"] == ["radii.csv"], r
 option = radii["options"][0]
 assert (option["name"], option["type"], option["default"], option["above"], option["max"]) == ("radii-scale", "number", 1.0, 0, 1000), option
 PY
-"$articula" run --help | grep -q -- "--radii-scale NUMBER=1 .*\[radii\] Factor on every semi-axis (above 0, up to 1000)" ||
+"$articula" run --help > "$tmp/help"
+grep -q -- "--radii-scale NUMBER=1 .*\[radii\] Factor on every semi-axis (above 0, up to 1000)" "$tmp/help" ||
   fail "run --help does not show --radii-scale with its default and range"
 # The driver without the stage knows nothing of it.
 expect_rc 2 "$bin/articula" run -i x -o "$tmp/none" --radii-scale 2

@@ -9,7 +9,8 @@ source "$(dirname "$0")/common.bash"
 mode=$(cat /sys/kernel/mm/transparent_hugepage/enabled 2> /dev/null || echo none)
 asked=no
 [[ $mode == *"[madvise]"* ]] && asked=yes
-ldd "$bin/articula" | grep -q libasan && asked=no
+# (read whole, not piped to grep -q: under pipefail its early exit fails ldd)
+[[ $(ldd "$bin/articula") == *libasan* ]] && asked=no
 
 # phantom_tunables FOLDER [VARIABLE=VALUE]: the glibc_tunables a phantom's
 # provenance records ("-": none), run without the caller's GLIBC_TUNABLES,

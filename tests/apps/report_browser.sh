@@ -23,7 +23,7 @@ browse() {
 # renderer's note that reading pixels back stalls (the view's own pixel
 # count) is the one allowed.
 check_console() {
-  if grep ':CONSOLE' "$1" | grep -v 'GL Driver Message (OpenGL, Performance' | grep -q .; then
+  if grep ':CONSOLE' "$1" | grep -v 'GL Driver Message (OpenGL, Performance' > /dev/null; then
     grep ':CONSOLE' "$1" >&2
     fail "console messages on $2"
   fi
