@@ -1,6 +1,9 @@
 // lib/core: atomic writes and the clean-up of temporaries a killed run leaves;
 // the output folder's lock; the encoding check of text tables.
+#include <atomic>
 #include <filesystem>
+#include <mutex>
+#include <stdexcept>
 #include <csignal>
 #include <fstream>
 #include <string>
@@ -17,6 +20,7 @@
 #include "articula/core/csv.hpp"
 #include "articula/core/error.hpp"
 #include "articula/core/output_lock.hpp"
+#include "articula/core/parallel.hpp"
 #include "articula/testsupport/scratch_dir.hpp"
 
 namespace articula {
@@ -158,6 +162,41 @@ TEST(CsvEncoding, Utf16AndNulBytesAreRefusedAUtf8MarkIsAccepted) {
                                            "(in Excel: Save As, 'CSV UTF-8')");
     }
   }
+}
+
+// Every index once, in ranges of at least min_chunk (but the last), on
+// several threads where asked; a throw from any range reaches the caller
+// after every thread has stopped.
+TEST(ParallelFor, EachIndexOnceInRangesOfAtLeastTheMinimum) {
+  for (const auto& [n, min_chunk, threads] :
+       std::vector<std::tuple<std::ptrdiff_t, std::ptrdiff_t, int>>{{1, 1, 4}, {7, 1, 3}, {1000, 8, 2}, {1000, 64, 4},
+                                                                   {100003, 2048, 3}, {50, 100, 4}}) {
+    std::vector<std::atomic<int>> seen(static_cast<size_t>(n));
+    std::mutex ranges_mutex;
+    std::vector<std::pair<std::ptrdiff_t, std::ptrdiff_t>> ranges;
+    parallelFor(n, min_chunk, threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+      for (std::ptrdiff_t i = begin; i < end; ++i) ++seen[static_cast<size_t>(i)];
+      std::lock_guard<std::mutex> lock(ranges_mutex);
+      ranges.emplace_back(begin, end);
+    });
+    for (std::ptrdiff_t i = 0; i < n; ++i) ASSERT_EQ(seen[static_cast<size_t>(i)], 1) << "n " << n << " index " << i;
+    for (const auto& [begin, end] : ranges) {
+      if (end != n) {
+        EXPECT_GE(end - begin, min_chunk) << "n " << n;
+      }
+    }
+    if (n / min_chunk >= threads) {
+      EXPECT_GE(ranges.size(), static_cast<size_t>(threads)) << "n " << n;
+    }
+    if (n < 2 * min_chunk) {
+      EXPECT_EQ(ranges.size(), 1u) << "n " << n;
+    }
+  }
+  EXPECT_THROW(parallelFor(10000, 10, 4,
+                                     [&](std::ptrdiff_t begin, std::ptrdiff_t) {
+                                       if (begin == 0) throw std::runtime_error("range 0");
+                                     }),
+               std::runtime_error);
 }
 
 }  // namespace
