@@ -477,7 +477,8 @@ std::optional<Side> sideBySocket(const Volume& volume, const HeadCandidate& head
 /// voxels facing them; the strongest on the requested side whose sphere is a
 /// plausible head is the head.
 /// Hand-written: ITK's Hough filters are 2-D only.
-bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side) {
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side,
+              std::optional<HeadCandidate>* outside_range) {
   const ImageGeometry& g = volume.geometry;
   Eigen::Vector3i factor;
   for (int a = 0; a < 3; ++a)
@@ -613,6 +614,18 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
       if (plausible(c) && (c.center - largest->center).norm() < 0.5 * largest->radius &&
           c.rms_mm / c.radius < best->rms_mm / best->radius)
         best = &c;
+  }
+  // A sphere as well measured but outside the radii a head may have: a head
+  // larger or smaller than the range expects is passed over for lesser bone
+  // (a trochanter), which the caller names.
+  if (outside_range) {
+    const HeadCandidate* passed_over = nullptr;
+    for (const HeadCandidate& c : candidates)
+      if (c.wellMeasured(g.spacing.maxCoeff()) && (c.radius < r_lo || c.radius > r_hi) &&
+          c.coverage >= options.min_coverage && insideVolume(g, c.center) && onSide(c) &&
+          (!best || c.area() > best->area()) && (!passed_over || c.area() > passed_over->area()))
+        passed_over = &c;
+    if (passed_over) *outside_range = *passed_over;
   }
   // In a narrow field without the body's outline, the socket says which
   // side the joint is: a joint of the other side is refused, not analysed.

@@ -67,14 +67,19 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
 /// comes from the body's middle (its outline, when whole in the field), else
 /// the field's middle (a field wide enough for both sides), else the socket
 /// (sideBySocket, one joint in a narrow field). `side` says how, or why the
-/// head was refused.
+/// head was refused. `outside_range`, when given, receives the largest
+/// well-measured sphere on the side whose radius lies outside the plausible
+/// range (SegmentOptions' min/max head radius) where it is larger than the
+/// head taken, or where none was: a head bigger or smaller than the range
+/// expects, which the search passed over.
 struct SideCheck {
   std::string how;           // empty: the side could not be verified
   bool other_side = false;   // the joint found is of the other side: refused
   std::optional<double> middle_x_mm;  // the body's middle (LPS x) the side was judged by, when one was
   bool middle_from_outline = false;   // from the body's outline (else the middle of a wide field of view)
 };
-bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side);
+bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate& head, SideCheck& side,
+              std::optional<HeadCandidate>* outside_range = nullptr);
 /// The side a joint is on from its socket, medial to it across the joint
 /// space (acetabulum, glenoid); none when too little socket is seen or it
 /// leans to neither side.

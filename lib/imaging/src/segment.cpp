@@ -264,7 +264,18 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     const std::string side = options.side == Side::Right ? "right" : "left";
     summary.seed_source = "automatic (" + joint + ", " + side + ")";
     SideCheck side_check;
-    const bool found = findHead(volume, options, head_found, side_check);
+    std::optional<HeadCandidate> outside_range;
+    const bool found = findHead(volume, options, head_found, side_check, &outside_range);
+    std::string passed_over;  // a sphere outside the radius range the search passed over, named
+    if (outside_range) {
+      std::ostringstream m;
+      m << "a spherical bone edge of radius " << std::lround(outside_range->radius * 10) / 10.0 << " mm at "
+        << vec(outside_range->center) << " mm, edges on " << std::lround(100 * outside_range->coverage)
+        << " % of its rays" << (found ? " (more bone surface than the head taken)" : "")
+        << ", lies outside the plausible head radii " << options.min_head_radius_mm << "-" << options.max_head_radius_mm
+        << " mm: if it is the head, widen --min-radius/--max-radius";
+      passed_over = m.str();
+    }
     if (side_check.other_side)
       throw ProcessingError("no " + std::string(options.joint == Joint::Hip ? "femoral" : "humeral") + " head on the " + side +
                             " side: " + side_check.how + " (the field of view holds one side only; run with --side " +
@@ -276,8 +287,10 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
         << " mm has bone edges over " << options.min_coverage << " of its surface within "
         << kMaxRelativeRms * 100 << " % of its radius RMS (-v lists the candidates);"
         << " give --seed-point X,Y,Z (LPS mm) or adjust --hu-min";
+      if (!passed_over.empty()) m << "; " << passed_over;
       throw ProcessingError(m.str());
     }
+    if (!passed_over.empty()) summary.warnings.push_back(passed_over);
     summary.side_check = side_check.how.empty() ? "not verified" : side_check.how;
     summary.body_middle_x_mm = side_check.middle_x_mm;
     if (side_check.middle_x_mm) summary.body_middle_from = side_check.middle_from_outline ? "outline" : "field of view";

@@ -129,6 +129,12 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
       for (const auto& w : seg.value("warnings", json::array()))
         if (w.is_string()) in.stage_warnings.push_back(w.get<std::string>());
       if (seg.contains("head_depth_mm")) in.label_depth_mm = seg.at("head_depth_mm").get<double>();
+      // The head radii the user allowed the search (--min-radius,
+      // --max-radius): a head found beyond the defaults with a widened range
+      // is held to that range.
+      const json parameters = seg.contains("provenance") ? seg.at("provenance").value("parameters", json::object()) : json::object();
+      if (parameters.contains("min_radius_mm")) in.min_radius_mm = parameters.at("min_radius_mm").get<double>();
+      if (parameters.contains("max_radius_mm")) in.max_radius_mm = parameters.at("max_radius_mm").get<double>();
       if (seg.value("seed_source", "").rfind("automatic", 0) == 0) {
         const auto& sc = seg.at("head_center_mm");
         in.search_center = Eigen::Vector3d(sc.at(0).get<double>(), sc.at(1).get<double>(), sc.at(2).get<double>());
