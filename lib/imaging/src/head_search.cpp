@@ -617,13 +617,16 @@ bool findHead(const Volume& volume, const SegmentOptions& options, HeadCandidate
   }
   // A sphere as well measured but outside the radii a head may have: a head
   // larger or smaller than the range expects is passed over for lesser bone
-  // (a trochanter), which the caller names.
+  // (a trochanter), which the caller names. Within a factor of the range:
+  // a screw's hole in the real 3 mm hip makes a sphere of 7 mm.
   if (outside_range) {
+    constexpr double kNamedBeyondRange = 1.5;
     const HeadCandidate* passed_over = nullptr;
     for (const HeadCandidate& c : candidates)
       if (c.wellMeasured(g.spacing.maxCoeff()) && (c.radius < r_lo || c.radius > r_hi) &&
+          c.radius > r_lo / kNamedBeyondRange && c.radius < r_hi * kNamedBeyondRange &&
           c.coverage >= options.min_coverage && insideVolume(g, c.center) && onSide(c) &&
-          (!best || c.area() > best->area()) && (!passed_over || c.area() > passed_over->area()))
+          (!passed_over || c.area() > passed_over->area()))
         passed_over = &c;
     if (passed_over) *outside_range = *passed_over;
   }

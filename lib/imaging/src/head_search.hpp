@@ -67,11 +67,11 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
 /// comes from the body's middle (its outline, when whole in the field), else
 /// the field's middle (a field wide enough for both sides), else the socket
 /// (sideBySocket, one joint in a narrow field). `side` says how, or why the
-/// head was refused. `outside_range`, when given, receives the largest
-/// well-measured sphere on the side whose radius lies outside the plausible
-/// range (SegmentOptions' min/max head radius) where it is larger than the
-/// head taken, or where none was: a head bigger or smaller than the range
-/// expects, which the search passed over.
+/// head was refused. `outside_range`, when given, receives the well-measured
+/// sphere on the side with the most bone surface (HeadCandidate::area) whose
+/// radius lies outside the plausible range (SegmentOptions' min/max head
+/// radius) but within a factor 1.5 of it: where it has more than the head
+/// taken, a head bigger or smaller than the range expects was passed over.
 struct SideCheck {
   std::string how;           // empty: the side could not be verified
   bool other_side = false;   // the joint found is of the other side: refused

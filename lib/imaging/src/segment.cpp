@@ -267,7 +267,7 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
     std::optional<HeadCandidate> outside_range;
     const bool found = findHead(volume, options, head_found, side_check, &outside_range);
     std::string passed_over;  // a sphere outside the radius range the search passed over, named
-    if (outside_range) {
+    if (outside_range && (!found || outside_range->area() > head_found.area())) {
       std::ostringstream m;
       m << "a spherical bone edge of radius " << std::lround(outside_range->radius * 10) / 10.0 << " mm at "
         << vec(outside_range->center) << " mm, edges on " << std::lround(100 * outside_range->coverage)
