@@ -17,8 +17,7 @@ int resolveThreads(int threads);
 
 /// Calls body(begin, end) on contiguous ranges covering [0, n), on up to
 /// `threads` threads (0: every hardware thread), each range at least
-/// `min_chunk` long (a small n runs on the calling thread); the threads take
-/// the ranges in turn, so which thread runs which range varies. The first
+/// `min_chunk` long (a small n runs on the calling thread). The first
 /// exception thrown by a range is rethrown here after every thread has
 /// finished.
 void parallelFor(std::ptrdiff_t n, std::ptrdiff_t min_chunk, int threads,
