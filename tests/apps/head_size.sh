@@ -5,8 +5,8 @@
 # radius and centre, and the options that take it in. With the range widened
 # the head is found, and the report's radius check holds it to that range,
 # not to the defaults.
-# (Heads within the range run in many tests; this one runs the release tier's
-# phantoms only, the search's code runs under the sanitizers there.)
+# Labelled full-size, so the release tier alone runs it; the search's code
+# runs under the sanitizers in the other head-search tests.
 # labels: full-size
 source "$(dirname "$0")/common.bash"
 
