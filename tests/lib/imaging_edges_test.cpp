@@ -138,6 +138,39 @@ TEST(Edges, FirstEdgeAlongARayIsTheHeadNotTheSocketBehindANarrowGap) {
   }
 }
 
+/// An osteoporotic head of radius 20 mm (a 0.8 mm cortex at 700 HU over 190
+/// HU), and, when `gap_mm` > 0, a socket across that gap (the same cortex
+/// and cancellous bone, 5 mm thick), in soft tissue at 40 HU, blurred
+/// radially by 0.5 mm: HU at r from its centre.
+double faintHeadHu(double r, double gap_mm) {
+  const auto layer = [r](double from, double to, double hu) { return (hu - 40) * (Phi((r - from) / 0.5) - Phi((r - to) / 0.5)); };
+  double hu = 40 + layer(-100, 19.2, 190) + layer(19.2, 20, 700);
+  if (gap_mm > 0) hu += layer(20 + gap_mm, 20.8 + gap_mm, 700) + layer(20.8 + gap_mm, 25, 190);
+  return hu;
+}
+
+// Across a 1 mm gap between faint cortices the gap's blurred valley lies
+// 145-165 HU below the head's cortex, about an edge's least contrast: the
+// first edge on a ray is then the head's on some rays and the socket's far
+// side on others (here along x, at 22 mm). The first fall into a valley is
+// the head's on every ray.
+TEST(Edges, FirstValleyAlongARayIsTheHeadAcrossAFaintNarrowGap) {
+  const imaging::Volume across_gap =
+      cubeAboutOrigin(110, 0.5, [](const Eigen::Vector3d& x) { return faintHeadHu(x.norm(), 1.0); });
+  const imaging::Volume alone = cubeAboutOrigin(110, 0.5, [](const Eigen::Vector3d& x) { return faintHeadHu(x.norm(), 0); });
+  for (const Eigen::Vector3d& u : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 1).normalized(),
+                                   Eigen::Vector3d(-0.2, 0.5, -0.8).normalized()}) {
+    const imaging::Edge valley = imaging::firstValleyAlongRay(across_gap, Eigen::Vector3d::Zero(), u, 6.0, 26.0, {});
+    ASSERT_TRUE(valley.found) << u.transpose();
+    EXPECT_NEAR(valley.offset_mm, 20.0, 0.25) << u.transpose();
+    // Alone, the head's edge has no valley beyond it: soft tissue, no rise.
+    EXPECT_FALSE(imaging::firstValleyAlongRay(alone, Eigen::Vector3d::Zero(), u, 6.0, 26.0, {}).found) << u.transpose();
+    const imaging::Edge edge = imaging::firstEdgeAlongRay(alone, Eigen::Vector3d::Zero(), u, 6.0, 26.0, {});
+    ASSERT_TRUE(edge.found);
+    EXPECT_NEAR(edge.offset_mm, 20.0, 0.25);
+  }
+}
+
 // A screw in the head (a 3.25 mm rod at 3,071 HU, a CT's ceiling, its tip
 // beyond the centre) lies on the rays cast from the centre: its fall is the
 // steepest on them, and the first. The ray's edge is the head's cortex all

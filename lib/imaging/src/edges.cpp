@@ -138,23 +138,59 @@ Edge locateEdge(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vec
   return e;
 }
 
-Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                       double from_mm, double to_mm, const EdgeSearch& search) {
-  const Profile p = sampleProfile(volume, origin, direction, from_mm, to_mm + kContrastReachMm, search);
-  if (p.value.size() < 3) return {};
+namespace {
+
+/// The steepest fall of the profile up to to_mm that is not a fall from
+/// metal: how steep a bone edge on this ray must be.
+double steepestBoneFall(const Profile& p, double to_mm) {
   // A ray through a screw meets the metal's falls first, and they are the
   // steepest: neither is a bone edge nor sets how steep one must be.
   double steepest = 0;
   for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n)
     if (p.slope[n] < steepest && edgeAt(p, n).inside_hu <= kMetalHu) steepest = p.slope[n];
+  return steepest;
+}
+
+/// The first fall up to to_mm as steep as a bone edge on this ray, from
+/// bone, not from metal, that `accept` takes.
+template <typename Accept>
+Edge firstFall(const Profile& p, double to_mm, const EdgeSearch& search, Accept accept) {
+  const double steepest = steepestBoneFall(p, to_mm);
   for (size_t n = 1; n + 1 < p.value.size() && p.t(n) <= to_mm; ++n) {
     if (!isFallingMinimum(p, n) || p.slope[n] > kRelativeStrength * steepest) continue;
     Edge e = edgeAt(p, n);
-    if (!strongEnough(e, search) || e.inside_hu > kMetalHu) continue;
+    if (e.inside_hu < search.min_inside_hu || e.inside_hu > kMetalHu || !accept(e, n)) continue;
     e.found = true;
     return e;
   }
   return {};
+}
+
+}  // namespace
+
+Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                       double from_mm, double to_mm, const EdgeSearch& search) {
+  const Profile p = sampleProfile(volume, origin, direction, from_mm, to_mm + kContrastReachMm, search);
+  if (p.value.size() < 3) return {};
+  return firstFall(p, to_mm, search, [&](const Edge& e, size_t) { return strongEnough(e, search); });
+}
+
+Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         double from_mm, double to_mm, const EdgeSearch& search, const ValleySearch& valley) {
+  const Profile p =
+      sampleProfile(volume, origin, direction, from_mm, to_mm + valley.rise_reach_mm + kContrastReachMm, search);
+  if (p.value.size() < 3) return {};
+  const auto reach = static_cast<size_t>(std::lround(valley.rise_reach_mm / p.step));
+  return firstFall(p, to_mm, search, [&](Edge& e, size_t n) {
+    // The valley's floor: where the profile stops falling beyond the edge.
+    size_t floor = n;
+    while (floor + 1 < p.value.size() && p.value[floor + 1] <= p.value[floor]) ++floor;
+    const size_t end = std::min(p.value.size() - 1, floor + reach);
+    if (floor == n || end == floor) return false;
+    const double rise = *std::max_element(p.value.begin() + static_cast<long>(floor), p.value.begin() + static_cast<long>(end) + 1);
+    e.outside_hu = p.value[floor];
+    return e.inside_hu - e.outside_hu >= valley.min_fall_hu && rise - e.outside_hu >= valley.min_rise_hu;
+  });
 }
 
 }  // namespace articula::imaging

@@ -83,7 +83,7 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
   // rays from elsewhere would not be the head's radius in their direction.
   for (int round = 0; round < kMaxRayRounds; ++round) {
     const Eigen::Vector3d ray_origin = c.center;
-    std::vector<Eigen::Vector3d> edges(kRayCount, Eigen::Vector3d::Constant(NAN));
+    std::vector<Eigen::Vector3d> edges(kRayCount, Eigen::Vector3d::Constant(NAN)), valleys = edges;
     std::vector<double> distances;
     for (int n = 0; n < kRayCount; ++n) {
       const Eigen::Vector3d u = geometry::fibonacciDirection(n, kRayCount);
@@ -91,6 +91,10 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       if (!e.found) continue;
       edges[static_cast<size_t>(n)] = c.center + e.offset_mm * u;
       distances.push_back(e.offset_mm);
+      const Edge v = firstValleyAlongRay(volume, c.center, u, 0.4 * r_lo, e.offset_mm, search);
+      if (v.found && v.offset_mm < e.offset_mm - kValleyShortOfEdgeMm && v.offset_mm >= e.offset_mm - kValleyGapReachMm &&
+          v.inside_hu >= kGapValleyPeakShare * e.inside_hu)
+        valleys[static_cast<size_t>(n)] = c.center + v.offset_mm * u;
     }
     if (distances.size() < 10) return unmeasured();
     std::sort(distances.begin(), distances.end());
@@ -102,15 +106,15 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       std::vector<char> inlier;
       int count = 0;
     };
-    const auto consensus = [&](double radius) -> std::optional<Consensus> {
-      Consensus fit{{c.center, radius}, std::vector<char>(edges.size(), 0), 0};
+    const auto consensus = [&](double radius, const std::vector<Eigen::Vector3d>& ray_edges) -> std::optional<Consensus> {
+      Consensus fit{{c.center, radius}, std::vector<char>(ray_edges.size(), 0), 0};
       for (double band_share : {0.12, 0.06, 0.04}) {
         const double band = std::max({band_share * fit.sphere.radius, 0.75 * voxel, 1.0});
         std::vector<Eigen::Vector3d> kept;
-        for (size_t n = 0; n < edges.size(); ++n) {
+        for (size_t n = 0; n < ray_edges.size(); ++n) {
           fit.inlier[n] =
-              !std::isnan(edges[n][0]) && std::abs((edges[n] - fit.sphere.center).norm() - fit.sphere.radius) <= band;
-          if (fit.inlier[n]) kept.push_back(edges[n]);
+              !std::isnan(ray_edges[n][0]) && std::abs((ray_edges[n] - fit.sphere.center).norm() - fit.sphere.radius) <= band;
+          if (fit.inlier[n]) kept.push_back(ray_edges[n]);
         }
         if (kept.size() < 10) return std::nullopt;
         Eigen::MatrixX3d points(static_cast<Eigen::Index>(kept.size()), 3);
@@ -124,20 +128,60 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       }
       return fit;
     };
-    const auto quantile = [&distances](double q) {
-      return distances[std::min(distances.size() - 1, static_cast<size_t>(q * double(distances.size())))];
+    const auto consensusRms = [](const Consensus& fit, const std::vector<Eigen::Vector3d>& ray_edges) {
+      double sse = 0;
+      for (size_t n = 0; n < ray_edges.size(); ++n)
+        if (fit.inlier[n]) sse += std::pow((ray_edges[n] - fit.sphere.center).norm() - fit.sphere.radius, 2);
+      return std::sqrt(sse / std::max(fit.count, 1));
     };
-    std::optional<Consensus> best = consensus(quantile(0.5));
+    const auto quantile = [](const std::vector<double>& sorted, double q) {
+      return sorted[std::min(sorted.size() - 1, static_cast<size_t>(q * double(sorted.size())))];
+    };
+    std::optional<Consensus> best = consensus(quantile(distances, 0.5), edges);
     // Metal's streaks inside the head give edges short of its surface on
     // the rays along them, which can outnumber the surface's: the median
     // then lies among them, and a sphere of a head's size a quarter of the
     // rays further out is taken where many more rays agree on it.
     for (double q : {0.25, 0.75})
-      if (std::optional<Consensus> other = consensus(quantile(q));
+      if (std::optional<Consensus> other = consensus(quantile(distances, q), edges);
           other && other->sphere.radius >= r_lo && other->sphere.radius <= r_hi &&
           (!best || other->count > kConsensusGain * best->count))
         best = std::move(other);
     if (!best) return unmeasured();
+    // Across a joint gap of about a millimetre between thin, faint cortices
+    // (osteoporotic bone) the gap's blurred valley need not fall as far as
+    // a bone edge must, and the first edge on many rays facing the socket
+    // is then the socket cortex's far side: the sphere runs between the two.
+    // Where the rays' valleys, put in place of their edges, make a sphere
+    // that as many rays agree on as closely, or nearly as many far more
+    // closely, it is the head's. (Inside a head, the valleys of its texture
+    // or of the noise make no sphere.)
+    std::vector<Eigen::Vector3d> nearer = edges;
+    std::vector<double> nearer_distances;
+    int valleys_taken = 0;
+    for (size_t n = 0; n < edges.size(); ++n) {
+      if (!std::isnan(valleys[n][0])) nearer[n] = valleys[n], ++valleys_taken;
+      if (!std::isnan(nearer[n][0])) nearer_distances.push_back((nearer[n] - c.center).norm());
+    }
+    std::sort(nearer_distances.begin(), nearer_distances.end());
+    if (valleys_taken >= kMinValleyRays) {
+      std::optional<Consensus> across_gap;
+      for (double q : {0.5, 0.25, 0.75}) {
+        if (std::optional<Consensus> other = consensus(quantile(nearer_distances, q), nearer);
+            other && other->sphere.radius >= r_lo && other->sphere.radius <= r_hi &&
+            (!across_gap || other->count > across_gap->count))
+          across_gap = std::move(other);
+      }
+      const auto takes = [&](const Consensus& gap) {
+        const double rms = consensusRms(gap, nearer), best_rms = consensusRms(*best, edges);
+        return (gap.count >= kValleyCountGain * best->count && rms <= kValleyRmsTie * best_rms) ||
+               (gap.count >= kValleyCountShare * best->count && rms <= kValleyRmsGain * best_rms);
+      };
+      if (across_gap && takes(*across_gap)) {
+        best = std::move(across_gap);
+        edges = std::move(nearer);
+      }
+    }
     const geometry::Sphere& sphere = best->sphere;
     const std::vector<char>& inlier = best->inlier;
     c.center = sphere.center;

@@ -39,6 +39,19 @@ constexpr int kMaxRayRounds = 8;
 // A sphere started from another quantile of the rays' edge distances than
 // the median replaces the median's when this many times as many edges agree.
 constexpr double kConsensusGain = 1.5;
+// A ray's valley (its first fall into a valley, imaging::firstValleyAlongRay:
+// a narrow joint gap's, too shallow for an edge) counts where it lies at
+// least kValleyShortOfEdgeMm and at most a joint gap and a thin cortex
+// (kValleyGapReachMm) short of the ray's edge; the valleys may take the
+// edges' place when at least kMinValleyRays rays have one.
+constexpr double kValleyShortOfEdgeMm = 0.5, kValleyGapReachMm = 3.5;
+constexpr int kMinValleyRays = 10;
+// The valleys' sphere replaces the edges' where a fifth more rays agree on
+// it as closely (within kValleyRmsTie of the RMS: the rays facing the
+// socket join the head's), or at least kValleyCountShare of them far more
+// closely (kValleyRmsGain: the edges' sphere ran between the head and the
+// socket's far side, looser than either).
+constexpr double kValleyCountGain = 1.2, kValleyRmsTie = 1.05, kValleyCountShare = 0.8, kValleyRmsGain = 0.75;
 
 /// A head measured from a point inside it: the sphere through the first bone
 /// edges seen on rays from that point, and the edges themselves.

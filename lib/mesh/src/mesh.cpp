@@ -286,8 +286,9 @@ namespace {
 /// outer end, the label may end inside the bone (a cortex so faint that the
 /// bone window cuts it millimetres inside its edge); with `look_further`,
 /// the first fall met going out within 3 mm (1.5 voxels) is taken then, if
-/// the way to it stays in bone (above the middle of that fall), so that a
-/// socket's cortex beyond a joint gap is never taken. Where the window holds
+/// the way to it stays in bone (above the middle of that fall) and crosses
+/// no joint gap's valley, so that a socket's cortex beyond a joint gap is
+/// never taken. Where the window holds
 /// no fall at all, the label may also end outside the bone: a flattened or
 /// eroded dome whose gap to the socket the segmentation's closing bridged
 /// (the label keeps the round head there, up to a quarter of its radius
@@ -304,6 +305,14 @@ imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, cons
   imaging::Edge further = imaging::firstEdgeAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
   further.offset_mm -= search.inward_mm;
   if (further.found && !(e.found && further.offset_mm <= e.offset_mm)) {
+    // A joint gap's valley on the way (between two cortices, and shallow
+    // enough to stay above that middle across a narrow gap between faint
+    // ones) puts `further` on the socket's far side.
+    const imaging::Edge valley =
+        imaging::firstValleyAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
+    if (valley.found && valley.offset_mm - search.inward_mm < further.offset_mm - 0.5 &&
+        valley.inside_hu >= imaging::kGapValleyPeakShare * further.inside_hu)
+      return e;
     const double middle = 0.5 * (further.inside_hu + further.outside_hu);
     for (double t = 0; t <= further.offset_mm - 0.5; t += 0.1)
       if (!(imaging::interpolate(ct, x + t * u) >= middle)) return e;

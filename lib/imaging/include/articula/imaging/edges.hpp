@@ -58,4 +58,28 @@ Edge locateEdge(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vec
 Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                        double from_mm, double to_mm, const EdgeSearch& search);
 
+/// A fall into a valley: the bone's edge where a narrow joint gap's blurred
+/// valley lies between the head's cortex and the socket's.
+struct ValleySearch {
+  double min_fall_hu = 80;     // from the bone side's maximum down to the valley's floor
+  double min_rise_hu = 50;     // from the floor up again, within rise_reach_mm beyond it
+  double rise_reach_mm = 3.0;
+};
+
+/// A valley is a joint gap's, between two cortices, where the bone before it
+/// (its edge's inside_hu) reaches at least this share of the bone beyond it
+/// (the far edge's): a valley of cancellous texture lies below the cortex
+/// that follows it.
+constexpr double kGapValleyPeakShare = 0.8;
+
+/// The first fall met going out from `origin` (as firstEdgeAlongRay, as
+/// steep and from bone) that ends in a valley: at least min_fall_hu down to
+/// its floor and rising again by min_rise_hu within rise_reach_mm beyond
+/// it. Across a joint gap of about a millimetre between thin, faint cortices
+/// the valley need not fall min_contrast_hu, and the first such edge is then
+/// the socket's far side; this one is the head's. Its outside_hu is the
+/// valley's floor.
+Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         double from_mm, double to_mm, const EdgeSearch& search, const ValleySearch& valley = {});
+
 }  // namespace articula::imaging
