@@ -151,15 +151,16 @@ PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d&
   if (points.rows() == 0 || normals.rows() != points.rows()) return shares;
   // The first bone edge met going out along the normal from 3 mm inside the
   // point (not the steepest: beyond a narrow gap a socket's cortex falls to
-  // its cancellous bone, often more steeply than the head's own edge), which
-  // must lie within half a voxel of the point.
+  // its cancellous bone, often more steeply than the head's own edge), or
+  // the fall into a gap's valley before it, which must lie within half a
+  // voxel of the point.
   const double voxel = ct.geometry.spacing.maxCoeff();
   const double reach = std::max(3.0, 1.5 * voxel), tolerance = std::max(0.5, 0.5 * voxel);
   Eigen::Index on_edge = 0, inside = 0;
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d n = normals.row(i).transpose().normalized();
     const imaging::Edge e =
-        imaging::firstEdgeAlongRay(ct, points.row(i).transpose() - reach * n, n, 0.0, 2 * reach, imaging::EdgeSearch{});
+        imaging::firstEdgeBeforeAGap(ct, points.row(i).transpose() - reach * n, n, 0.0, 2 * reach, imaging::EdgeSearch{});
     const double offset = e.offset_mm - reach;
     on_edge += e.found && std::abs(offset) <= tolerance;
     inside += e.found && offset > tolerance;

@@ -193,4 +193,14 @@ Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, co
   });
 }
 
+Edge firstEdgeBeforeAGap(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         double from_mm, double to_mm, const EdgeSearch& search) {
+  const Edge edge = firstEdgeAlongRay(volume, origin, direction, from_mm, to_mm, search);
+  if (!edge.found) return edge;
+  const Edge valley = firstValleyAlongRay(volume, origin, direction, from_mm, edge.offset_mm, search);
+  const bool gap = valley.found && valley.offset_mm < edge.offset_mm - 0.5 &&
+                   valley.inside_hu >= kGapValleyPeakShare * edge.inside_hu;
+  return gap ? valley : edge;
+}
+
 }  // namespace articula::imaging

@@ -302,17 +302,11 @@ imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, cons
   const imaging::Edge e = imaging::locateEdge(ct, x, u, search);
   if (!look_further || (e.found && e.offset_mm <= search.outward_mm - 0.15)) return e;
   const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
-  imaging::Edge further = imaging::firstEdgeAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
+  // Before a joint gap's valley, not beyond it: a narrow gap between faint
+  // cortices blurs to a valley above the middle of the socket cortex's far fall.
+  imaging::Edge further = imaging::firstEdgeBeforeAGap(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
   further.offset_mm -= search.inward_mm;
   if (further.found && !(e.found && further.offset_mm <= e.offset_mm)) {
-    // A joint gap's valley on the way (between two cortices, and shallow
-    // enough to stay above that middle across a narrow gap between faint
-    // ones) puts `further` on the socket's far side.
-    const imaging::Edge valley =
-        imaging::firstValleyAlongRay(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
-    if (valley.found && valley.offset_mm - search.inward_mm < further.offset_mm - 0.5 &&
-        valley.inside_hu >= imaging::kGapValleyPeakShare * further.inside_hu)
-      return e;
     const double middle = 0.5 * (further.inside_hu + further.outside_hu);
     for (double t = 0; t <= further.offset_mm - 0.5; t += 0.1)
       if (!(imaging::interpolate(ct, x + t * u) >= middle)) return e;

@@ -61,7 +61,7 @@ Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, cons
 /// A fall into a valley: the bone's edge where a narrow joint gap's blurred
 /// valley lies between the head's cortex and the socket's.
 struct ValleySearch {
-  double min_fall_hu = 80;     // from the bone side's maximum down to the valley's floor
+  double min_fall_hu = 60;     // from the bone side's maximum down to the valley's floor
   double min_rise_hu = 50;     // from the floor up again, within rise_reach_mm beyond it
   double rise_reach_mm = 3.0;
 };
@@ -81,5 +81,13 @@ constexpr double kGapValleyPeakShare = 0.8;
 /// valley's floor.
 Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                          double from_mm, double to_mm, const EdgeSearch& search, const ValleySearch& valley = {});
+
+/// The first bone edge met going out (firstEdgeAlongRay), or, where a joint
+/// gap's valley lies before it (firstValleyAlongRay, at least half a
+/// millimetre short of it, its bone at least kGapValleyPeakShare of the
+/// edge's), the fall into that valley: the head's edge, not the socket
+/// cortex's far side.
+Edge firstEdgeBeforeAGap(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         double from_mm, double to_mm, const EdgeSearch& search);
 
 }  // namespace articula::imaging
