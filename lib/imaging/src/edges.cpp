@@ -189,14 +189,15 @@ Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, co
     if (floor == n || end == floor) return false;
     const double rise = *std::max_element(p.value.begin() + static_cast<long>(floor), p.value.begin() + static_cast<long>(end) + 1);
     e.outside_hu = p.value[floor];
-    return e.inside_hu - e.outside_hu >= valley.min_fall_hu && rise - e.outside_hu >= valley.min_rise_hu;
+    return e.inside_hu - e.outside_hu >= std::max(valley.min_fall_hu, valley.min_fall_share * e.inside_hu) &&
+           rise - e.outside_hu >= valley.min_rise_hu;
   });
 }
 
 Edge firstEdgeBeforeAGap(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                          double from_mm, double to_mm, const EdgeSearch& search) {
   const Edge edge = firstEdgeAlongRay(volume, origin, direction, from_mm, to_mm, search);
-  if (!edge.found) return edge;
+  if (!edge.found || volume.geometry.spacing.maxCoeff() > kGapValleyMaxVoxelMm + 1e-6) return edge;
   const Edge valley = firstValleyAlongRay(volume, origin, direction, from_mm, edge.offset_mm, search);
   const bool gap = valley.found && valley.offset_mm < edge.offset_mm - 0.5 &&
                    valley.inside_hu >= kGapValleyPeakShare * edge.inside_hu;
