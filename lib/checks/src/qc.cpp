@@ -159,8 +159,8 @@ PointsOnCtEdge pointsOnCtEdge(const imaging::Volume& ct, const Eigen::MatrixX3d&
   Eigen::Index on_edge = 0, inside = 0;
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d n = normals.row(i).transpose().normalized();
-    const imaging::Edge e =
-        imaging::firstEdgeBeforeAGap(ct, points.row(i).transpose() - reach * n, n, 0.0, 2 * reach, imaging::EdgeSearch{});
+    const imaging::Edge e = imaging::firstEdgeBeforeAGap(ct, points.row(i).transpose() - reach * n, n, 0.0, 2 * reach,
+                                                         imaging::EdgeSearch{});
     const double offset = e.offset_mm - reach;
     on_edge += e.found && std::abs(offset) <= tolerance;
     inside += e.found && offset > tolerance;

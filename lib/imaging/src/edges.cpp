@@ -187,7 +187,8 @@ Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, co
     while (floor + 1 < p.value.size() && p.value[floor + 1] <= p.value[floor]) ++floor;
     const size_t end = std::min(p.value.size() - 1, floor + reach);
     if (floor == n || end == floor) return false;
-    const double rise = *std::max_element(p.value.begin() + static_cast<long>(floor), p.value.begin() + static_cast<long>(end) + 1);
+    const double rise =
+        *std::max_element(p.value.begin() + static_cast<long>(floor), p.value.begin() + static_cast<long>(end) + 1);
     e.outside_hu = p.value[floor];
     return e.inside_hu - e.outside_hu >= std::max(valley.min_fall_hu, valley.min_fall_share * e.inside_hu) &&
            rise - e.outside_hu >= valley.min_rise_hu;

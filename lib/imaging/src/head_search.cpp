@@ -92,7 +92,8 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       edges[static_cast<size_t>(n)] = c.center + e.offset_mm * u;
       distances.push_back(e.offset_mm);
       const Edge v = firstValleyAlongRay(volume, c.center, u, 0.4 * r_lo, e.offset_mm, search);
-      if (v.found && v.offset_mm < e.offset_mm - kValleyShortOfEdgeMm && v.offset_mm >= e.offset_mm - kValleyGapReachMm &&
+      const double short_of_edge = e.offset_mm - v.offset_mm;
+      if (v.found && short_of_edge > kValleyShortOfEdgeMm && short_of_edge <= kValleyGapReachMm &&
           v.inside_hu >= kGapValleyPeakShare * e.inside_hu)
         valleys[static_cast<size_t>(n)] = c.center + v.offset_mm * u;
     }
@@ -106,14 +107,15 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       std::vector<char> inlier;
       int count = 0;
     };
-    const auto consensus = [&](double radius, const std::vector<Eigen::Vector3d>& ray_edges) -> std::optional<Consensus> {
+    const auto consensus = [&](double radius,
+                               const std::vector<Eigen::Vector3d>& ray_edges) -> std::optional<Consensus> {
       Consensus fit{{c.center, radius}, std::vector<char>(ray_edges.size(), 0), 0};
       for (double band_share : {0.12, 0.06, 0.04}) {
         const double band = std::max({band_share * fit.sphere.radius, 0.75 * voxel, 1.0});
         std::vector<Eigen::Vector3d> kept;
         for (size_t n = 0; n < ray_edges.size(); ++n) {
-          fit.inlier[n] =
-              !std::isnan(ray_edges[n][0]) && std::abs((ray_edges[n] - fit.sphere.center).norm() - fit.sphere.radius) <= band;
+          fit.inlier[n] = !std::isnan(ray_edges[n][0]) &&
+                          std::abs((ray_edges[n] - fit.sphere.center).norm() - fit.sphere.radius) <= band;
           if (fit.inlier[n]) kept.push_back(ray_edges[n]);
         }
         if (kept.size() < 10) return std::nullopt;
@@ -153,7 +155,7 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
     // a bone edge must, and the first edge on many rays facing the socket
     // is then the socket cortex's far side: the sphere runs between the two.
     // Where the rays' valleys, put in place of their edges, make a sphere
-    // that as many rays agree on as closely, or nearly as many far more
+    // that a fifth more rays agree on as closely, or nearly as many far more
     // closely, it is the head's. (Inside a head, the valleys of its texture
     // or of the noise make no sphere.)
     std::vector<Eigen::Vector3d> nearer = edges;

@@ -286,13 +286,12 @@ namespace {
 /// outer end, the label may end inside the bone (a cortex so faint that the
 /// bone window cuts it millimetres inside its edge); with `look_further`,
 /// the first fall met going out within 3 mm (1.5 voxels) is taken then, if
-/// the way to it stays in bone (above the middle of that fall) and crosses
-/// no joint gap's valley, so that a socket's cortex beyond a joint gap is
-/// never taken. Where the window holds
-/// no fall at all, the label may also end outside the bone: a flattened or
-/// eroded dome whose gap to the socket the segmentation's closing bridged
-/// (the label keeps the round head there, up to a quarter of its radius
-/// above the bone). The first fall met going out from kLabelOutsideReachMm
+/// the way to it stays in bone (above the middle of that fall), and before a
+/// joint gap's valley, so that a socket's cortex beyond a joint gap is never
+/// taken. Where the window holds no fall at all, the label may also end
+/// outside the bone: a flattened or eroded dome whose gap to the socket the
+/// segmentation's closing bridged (the label keeps the round head there, up
+/// to a quarter of its radius above the bone). The first fall met going out from kLabelOutsideReachMm
 /// inside is taken then, if the way from it to x and a millimetre beyond
 /// stays out of bone (below the middle of that fall), so that no edge within
 /// the bone is taken.
@@ -304,7 +303,8 @@ imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, cons
   const double reach_mm = std::max(3.0, 1.5 * ct.geometry.spacing.maxCoeff());
   // Before a joint gap's valley, not beyond it: a narrow gap between faint
   // cortices blurs to a valley above the middle of the socket cortex's far fall.
-  imaging::Edge further = imaging::firstEdgeBeforeAGap(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
+  imaging::Edge further =
+      imaging::firstEdgeBeforeAGap(ct, x - search.inward_mm * u, u, 0.0, search.inward_mm + reach_mm, search);
   further.offset_mm -= search.inward_mm;
   if (further.found && !(e.found && further.offset_mm <= e.offset_mm)) {
     const double middle = 0.5 * (further.inside_hu + further.outside_hu);
