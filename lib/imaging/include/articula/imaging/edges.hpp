@@ -61,9 +61,9 @@ Edge firstEdgeAlongRay(const Volume& volume, const Eigen::Vector3d& origin, cons
 /// A fall into a valley: the bone's edge where a narrow joint gap's blurred
 /// valley lies between the head's cortex and the socket's.
 struct ValleySearch {
-  double min_fall_hu = 60;     // from the bone side's maximum down to the valley's floor ...
-  double min_fall_share = 0.15;  // ... and at least this share of that maximum (a dip in a bright cortex is no gap)
-  double min_rise_hu = 50;     // from the floor up again, within rise_reach_mm beyond it
+  double min_fall_hu = 60;       // from the bone side's maximum down to the valley's floor,
+  double min_fall_share = 0.15;  // and this share of that maximum (a dip in a bright cortex is no gap)
+  double min_rise_hu = 50;       // from the floor up again, within rise_reach_mm beyond it
   double rise_reach_mm = 3.0;
 };
 
@@ -79,11 +79,11 @@ constexpr double kGapValleyMaxVoxelMm = 1.25;
 
 /// The first fall met going out from `origin` (as firstEdgeAlongRay, as
 /// steep and from bone) that ends in a valley: at least min_fall_hu (and
-/// min_fall_share of the bone's HU) down to its floor and rising again by min_rise_hu within rise_reach_mm beyond
-/// it. Across a joint gap of about a millimetre between thin, faint cortices
-/// the valley need not fall min_contrast_hu, and the first such edge is then
-/// the socket's far side; this one is the head's. Its outside_hu is the
-/// valley's floor.
+/// min_fall_share of the bone's HU) down to its floor, and rising again by
+/// min_rise_hu within rise_reach_mm beyond it. Across a joint gap of about a
+/// millimetre between thin, faint cortices the valley need not fall
+/// min_contrast_hu, and the first edge is then the socket's far side; this
+/// fall is the head's. Its outside_hu is the valley's floor.
 Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                          double from_mm, double to_mm, const EdgeSearch& search, const ValleySearch& valley = {});
 
