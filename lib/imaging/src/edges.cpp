@@ -195,14 +195,17 @@ Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, co
   });
 }
 
+bool isGapValleyBefore(const Edge& valley, const Edge& edge) {
+  return valley.found && edge.found && edge.offset_mm - valley.offset_mm > kGapValleyShortOfEdgeMm &&
+         valley.inside_hu >= kGapValleyPeakShare * edge.inside_hu;
+}
+
 Edge firstEdgeBeforeAGap(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                          double from_mm, double to_mm, const EdgeSearch& search) {
   const Edge edge = firstEdgeAlongRay(volume, origin, direction, from_mm, to_mm, search);
   if (!edge.found || volume.geometry.spacing.maxCoeff() > kGapValleyMaxVoxelMm + 1e-6) return edge;
   const Edge valley = firstValleyAlongRay(volume, origin, direction, from_mm, edge.offset_mm, search);
-  const bool gap = valley.found && valley.offset_mm < edge.offset_mm - 0.5 &&
-                   valley.inside_hu >= kGapValleyPeakShare * edge.inside_hu;
-  return gap ? valley : edge;
+  return isGapValleyBefore(valley, edge) ? valley : edge;
 }
 
 }  // namespace articula::imaging

@@ -92,9 +92,7 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
       edges[static_cast<size_t>(n)] = c.center + e.offset_mm * u;
       distances.push_back(e.offset_mm);
       const Edge v = firstValleyAlongRay(volume, c.center, u, 0.4 * r_lo, e.offset_mm, search);
-      const double short_of_edge = e.offset_mm - v.offset_mm;
-      if (v.found && short_of_edge > kValleyShortOfEdgeMm && short_of_edge <= kValleyGapReachMm &&
-          v.inside_hu >= kGapValleyPeakShare * e.inside_hu)
+      if (isGapValleyBefore(v, e) && e.offset_mm - v.offset_mm <= kValleyGapReachMm)
         valleys[static_cast<size_t>(n)] = c.center + v.offset_mm * u;
     }
     if (distances.size() < 10) return unmeasured();
@@ -133,7 +131,10 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
     const auto consensusRms = [](const Consensus& fit, const std::vector<Eigen::Vector3d>& ray_edges) {
       double sse = 0;
       for (size_t n = 0; n < ray_edges.size(); ++n)
-        if (fit.inlier[n]) sse += std::pow((ray_edges[n] - fit.sphere.center).norm() - fit.sphere.radius, 2);
+        if (fit.inlier[n]) {
+          const double residual = (ray_edges[n] - fit.sphere.center).norm() - fit.sphere.radius;
+          sse += residual * residual;
+        }
       return std::sqrt(sse / std::max(fit.count, 1));
     };
     const auto quantile = [](const std::vector<double>& sorted, double q) {
@@ -158,15 +159,16 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
     // that a fifth more rays agree on as closely, or nearly as many far more
     // closely, it is the head's. (Inside a head, the valleys of its texture
     // or of the noise make no sphere.)
-    std::vector<Eigen::Vector3d> nearer = edges;
-    std::vector<double> nearer_distances;
-    int valleys_taken = 0;
-    for (size_t n = 0; n < edges.size(); ++n) {
-      if (!std::isnan(valleys[n][0])) nearer[n] = valleys[n], ++valleys_taken;
-      if (!std::isnan(nearer[n][0])) nearer_distances.push_back((nearer[n] - c.center).norm());
-    }
-    std::sort(nearer_distances.begin(), nearer_distances.end());
+    const auto valleys_taken =
+        std::count_if(valleys.begin(), valleys.end(), [](const Eigen::Vector3d& v) { return !std::isnan(v[0]); });
     if (valleys_taken >= kMinValleyRays) {
+      std::vector<Eigen::Vector3d> nearer = edges;
+      std::vector<double> nearer_distances;
+      for (size_t n = 0; n < edges.size(); ++n) {
+        if (!std::isnan(valleys[n][0])) nearer[n] = valleys[n];
+        if (!std::isnan(nearer[n][0])) nearer_distances.push_back((nearer[n] - c.center).norm());
+      }
+      std::sort(nearer_distances.begin(), nearer_distances.end());
       std::optional<Consensus> across_gap;
       for (double q : {0.5, 0.25, 0.75}) {
         if (std::optional<Consensus> other = consensus(quantile(nearer_distances, q), nearer);
@@ -188,8 +190,6 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
     const std::vector<char>& inlier = best->inlier;
     c.center = sphere.center;
     c.radius = sphere.radius;
-    double sse = 0;
-    int used = 0;
     c.edge_mm.assign(edges.size(), NAN);
     c.short_of_sphere.assign(edges.size(), 0);
     for (size_t n = 0; n < edges.size(); ++n) {
@@ -197,15 +197,12 @@ HeadCandidate measureHeadByRays(const Volume& volume, const Eigen::Vector3d& sta
         c.short_of_sphere[n] = !std::isnan(edges[n][0]) && (edges[n] - sphere.center).norm() < sphere.radius;
         continue;
       }
-      const double residual = (edges[n] - sphere.center).norm() - sphere.radius;
-      sse += residual * residual;
-      ++used;
       // The edge's distance from the final centre along its ray's direction
       // (the ray left from the previous centre, within half a millimetre).
       c.edge_mm[n] = (edges[n] - sphere.center).dot(geometry::fibonacciDirection(static_cast<int>(n), kRayCount));
     }
-    c.coverage = static_cast<double>(used) / kRayCount;
-    c.rms_mm = std::sqrt(sse / std::max(used, 1));
+    c.coverage = static_cast<double>(best->count) / kRayCount;
+    c.rms_mm = consensusRms(*best, edges);
     if (round > 0 && (c.center - ray_origin).norm() <= 0.5) return c;
   }
   return unmeasured();

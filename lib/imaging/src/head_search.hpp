@@ -40,11 +40,11 @@ constexpr int kMaxRayRounds = 8;
 // the median replaces the median's when this many times as many edges agree.
 constexpr double kConsensusGain = 1.5;
 // A ray's valley (its first fall into a valley, imaging::firstValleyAlongRay:
-// a narrow joint gap's, too shallow for an edge) counts where it lies at
-// least kValleyShortOfEdgeMm and at most a joint gap and a thin cortex
-// (kValleyGapReachMm) short of the ray's edge; the valleys may take the
-// edges' place when at least kMinValleyRays rays have one.
-constexpr double kValleyShortOfEdgeMm = 0.5, kValleyGapReachMm = 3.5;
+// a narrow joint gap's, too shallow for an edge) counts where it is a gap's
+// before the ray's edge (imaging::isGapValleyBefore) and at most a joint gap
+// and a thin cortex (kValleyGapReachMm) short of it; the valleys may take
+// the edges' place when at least kMinValleyRays rays have one.
+constexpr double kValleyGapReachMm = 3.5;
 constexpr int kMinValleyRays = 10;
 // The valleys' sphere replaces the edges' where a fifth more rays agree on
 // it as closely (within kValleyRmsTie of the RMS: the rays facing the

@@ -87,11 +87,18 @@ constexpr double kGapValleyMaxVoxelMm = 1.25;
 Edge firstValleyAlongRay(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                          double from_mm, double to_mm, const EdgeSearch& search, const ValleySearch& valley = {});
 
+/// A valley lies this far short of the edge at least to be a gap's before it.
+constexpr double kGapValleyShortOfEdgeMm = 0.5;
+
+/// Whether `valley` (firstValleyAlongRay) is a joint gap's before `edge`
+/// (firstEdgeAlongRay on the same line): more than kGapValleyShortOfEdgeMm
+/// short of it, its bone at least kGapValleyPeakShare of the edge's.
+bool isGapValleyBefore(const Edge& valley, const Edge& edge);
+
 /// The first bone edge met going out (firstEdgeAlongRay), or, where a joint
-/// gap's valley lies before it (firstValleyAlongRay, at least half a
-/// millimetre short of it, its bone at least kGapValleyPeakShare of the
-/// edge's) and the voxels are at most kGapValleyMaxVoxelMm, the fall into
-/// that valley: the head's edge, not the socket cortex's far side.
+/// gap's valley lies before it (isGapValleyBefore) and the voxels are at
+/// most kGapValleyMaxVoxelMm, the fall into that valley: the head's edge,
+/// not the socket cortex's far side.
 Edge firstEdgeBeforeAGap(const Volume& volume, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                          double from_mm, double to_mm, const EdgeSearch& search);
 
