@@ -118,6 +118,8 @@ class SegmentCommand : public cli::Command {
         {"threshold_voxels", s.threshold_voxels},
         {"label_voxels", s.label_voxels},
         {"cut_through_bone_voxels", s.cut_through_bone_voxels},
+        {"noise_hu", s.noise_hu},
+        {"smoothed_sigma_mm", s.smoothed_sigma_mm},
         {"warnings", warnings},
         {"provenance", provenanceJson({params, inputs, -1, common.threadCount()})}};
     writeFileAtomically(output_.string() + ".json", summary.dump(2) + "\n", true);

@@ -13,6 +13,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/imaging/io.hpp"
+#include "articula/imaging/noise.hpp"
 #include "articula/imaging/segment.hpp"
 #include "ct_test_support.hpp"
 
@@ -490,6 +491,31 @@ TEST(ImagingSegment, AFaintHeadsSocketAcrossANarrowGapIsCutOffAtFineSlices) {
     EXPECT_GT(h.head_recall, 0.95);
     EXPECT_LT(h.socket_leak, 0.02);
   }
+}
+
+TEST(ImagingSegment, ANoisySharpKernelScanIsSegmentedOnASmoothedCopy) {
+  // A sharp kernel over 100 HU of noise (about 150 HU voxel to voxel): falls
+  // of an edge's size lie all through the cancellous bone, every ray of the
+  // head search stopped on one, and no head was found (the candidates'
+  // spheres 8-9 mm across). Smoothed by an in-plane voxel, the head is
+  // found and labelled as at low noise.
+  phantom::PhantomOptions o = clinicalHead(5, geometry::ShapeModel::Sphere, 24, false, {0.8, 0.8, 0.8}, 3.0);
+  o.kernel = phantom::PhantomOptions::Kernel::Sharp;
+  o.noise_hu = 100;
+  const phantom::Phantom p = phantom::makePhantom(o);
+  imaging::SegmentOptions so;
+  so.side = imaging::Side::Left;
+  imaging::SegmentSummary s;
+  const HeadCheck h = segmentAndCheck(p, so, s);
+  EXPECT_GT(s.noise_hu, imaging::kSmoothSegmentationAboveNoiseHu);
+  EXPECT_NEAR(s.smoothed_sigma_mm, 0.8, 1e-6);
+  EXPECT_EQ(s.head_found_by, "edges");
+  EXPECT_LT(h.center_error_mm, 0.5);
+  EXPECT_NEAR(s.search_radius_mm, p.head.radii.mean(), 0.5);
+  EXPECT_GT(h.head_recall, 0.95);
+  EXPECT_LT(h.socket_leak, 0.02);
+  ASSERT_FALSE(s.warnings.empty());
+  EXPECT_NE(s.warnings.front().find("smoothed"), std::string::npos);
 }
 
 TEST(ImagingSegment, SeedPointAndFailures) {

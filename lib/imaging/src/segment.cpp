@@ -17,6 +17,7 @@
 
 #include "articula/core/error.hpp"
 #include "articula/core/log.hpp"
+#include "articula/imaging/noise.hpp"
 #include "head_search.hpp"
 #include "itk_bridge.hpp"
 
@@ -215,9 +216,37 @@ void SegmentOptions::validate() const {
   range(min_coverage, 0, 1, "--min-coverage");
 }
 
-Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSummary* summary_out) {
+namespace {
+Label segmentHeadIn(const Volume& volume, const SegmentOptions& options, SegmentSummary& summary);
+}  // namespace
+
+Label segmentHead(const Volume& ct, const SegmentOptions& options, SegmentSummary* summary_out) {
   options.validate();
   SegmentSummary summary;
+  summary.noise_hu = noiseHu(ct);
+  log::debug("the CT's noise voxel to voxel: " + std::to_string(summary.noise_hu) + " HU");
+  // A noisy CT (low dose, a sharp kernel) is segmented on a copy smoothed by
+  // an in-plane voxel: the label only has to hold the head, whose surface the
+  // mesh stage places on the CT's own voxels.
+  Volume calm;
+  if (summary.noise_hu > kSmoothSegmentationAboveNoiseHu) {
+    summary.smoothed_sigma_mm = std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]);
+    calm = smoothed(ct, summary.smoothed_sigma_mm);
+    std::ostringstream m;
+    m << "the CT's noise is about " << std::lround(summary.noise_hu) << " HU voxel to voxel (a low dose or a sharp "
+      << "kernel; over " << kSmoothSegmentationAboveNoiseHu << " HU): the head was searched and labelled on a copy "
+      << "smoothed by a Gaussian of " << summary.smoothed_sigma_mm << " mm, its surface placed on the CT's own voxels";
+    summary.warnings.push_back(m.str());
+    log::info(m.str());
+  }
+  Label label = segmentHeadIn(summary.smoothed_sigma_mm > 0 ? calm : ct, options, summary);
+  if (summary_out) *summary_out = summary;
+  return label;
+}
+
+namespace {
+
+Label segmentHeadIn(const Volume& volume, const SegmentOptions& options, SegmentSummary& summary) {
   const ImageGeometry& g = volume.geometry;
 
   // 1. HU window within the ROI.
@@ -459,8 +488,8 @@ Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSu
           summary.cut_through_bone_voxels += cut;
         }
   if (summary.label_voxels == 0) throw ProcessingError("the head label is empty after separation");
-  if (summary_out) *summary_out = summary;
   return label;
 }
 
+}  // namespace
 }  // namespace articula::imaging

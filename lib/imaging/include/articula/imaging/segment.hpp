@@ -65,6 +65,8 @@ struct SegmentSummary {
   long long threshold_voxels = 0;           // voxels in the HU window (within the ROI)
   long long label_voxels = 0;
   long long cut_through_bone_voxels = 0;    // of label_voxels, those labelled kLabelCutThroughBone
+  double noise_hu = 0;                      // the CT's noise voxel to voxel (imaging/noise.hpp)
+  double smoothed_sigma_mm = 0;             // the Gaussian the head was segmented after (0: none, the CT as read)
   std::vector<std::string> warnings;
 };
 
