@@ -267,6 +267,20 @@ TEST(HeadQc, MetalNearTheHeadWarns) {
   EXPECT_EQ(check(checks::checkHead(in), "metal_near_head_mm3").status, "pass");
 }
 
+TEST(HeadQc, ANoisyCtWarnsByItsOwnNameAndIsNoDoubtOfThePoints) {
+  // The segmentation's measure of a sharp kernel over 100 HU of noise, and
+  // of a phantom at 20 HU.
+  checks::HeadQcInput in = cap(23, 85);
+  in.ct_noise_hu = 157;
+  const checks::QcReport r = checks::checkHead(in);
+  EXPECT_EQ(check(r, "ct_noise_hu").status, "warn");
+  EXPECT_FALSE(check(r, "ct_noise_hu").of_structure);
+  EXPECT_NE(check(r, "ct_noise_hu").reason.find("smoothed copy"), std::string::npos);
+  EXPECT_EQ(r.status, "warn");
+  in.ct_noise_hu = 20;
+  EXPECT_EQ(check(checks::checkHead(in), "ct_noise_hu").status, "pass");
+}
+
 TEST(HeadQc, TheSurfaceRunIntoBoneBeyondWarnsByItsOwnNameAndIsNoDoubtOfThePoints) {
   // A departure of the bone and a region with bone beyond it, each over
   // 395 mm^2 (the socket's roof a thick-sliced phantom head's pole took).

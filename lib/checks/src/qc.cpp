@@ -8,6 +8,7 @@
 #include "articula/core/error.hpp"
 #include "articula/geometry/fibonacci.hpp"
 #include "articula/imaging/edges.hpp"
+#include "articula/imaging/noise.hpp"
 #include "articula/checks/cap_departures.hpp"
 
 namespace articula::checks {
@@ -391,6 +392,15 @@ QcReport checkHead(const HeadQcInput& in) {
     if (metal.status == "warn")
       metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
     report.checks.push_back(metal);
+  }
+  if (in.ct_noise_hu) {
+    QcCheck noise = grade("ct_noise_hu", *in.ct_noise_hu, imaging::kSmoothSegmentationAboveNoiseHu, std::nullopt, false,
+                          "a noisy CT (a low dose or a sharp kernel): its noise voxel to voxel (HU) is");
+    noise.of_structure = false;
+    if (noise.status == "warn")
+      noise.reason += ": the head was searched and labelled on a smoothed copy, its surface placed on the noisy voxels; "
+                      "check the head on the slices";
+    report.checks.push_back(noise);
   }
   // Regions of the cap off the model (cap_departures.hpp) warn from
   // kDepartureWarnMm2 and are no doubt about the structure: the band of

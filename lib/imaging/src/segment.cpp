@@ -236,8 +236,7 @@ Label segmentHead(const Volume& ct, const SegmentOptions& options, SegmentSummar
     m << "the CT's noise is about " << std::lround(summary.noise_hu) << " HU voxel to voxel (a low dose or a sharp "
       << "kernel; over " << kSmoothSegmentationAboveNoiseHu << " HU): the head was searched and labelled on a copy "
       << "smoothed by a Gaussian of " << summary.smoothed_sigma_mm << " mm, its surface placed on the CT's own voxels";
-    summary.warnings.push_back(m.str());
-    log::info(m.str());
+    log::warn(m.str());  // the report's check ct_noise_hu says it too
   }
   Label label = segmentHeadIn(summary.smoothed_sigma_mm > 0 ? calm : ct, options, summary);
   if (summary_out) *summary_out = summary;

@@ -50,6 +50,7 @@ struct HeadQcInput {
   std::optional<double> cortex_contrast_across_slices;  // cortexContrastAcrossSlices, where measurable
   std::optional<double> head_outside_volume_share;  // headOutsideVolumeShare, where a CT was given
   std::optional<double> metal_near_head_mm3;     // metalNearHead, where a CT was given
+  std::optional<double> ct_noise_hu;             // the segmentation's measure of the CT's noise (imaging/noise.hpp)
   std::optional<double> cap_departure_mm2;       // CapDepartures::largestFindingMm2, where the bone's mesh was given
   std::optional<double> cap_bone_beyond_mm2;     // CapDepartures::largestBoneBeyondMm2, where the mesh was given
   std::vector<std::string> stage_warnings;       // what the stages warned of (the segmentation's summary: reading, search)
