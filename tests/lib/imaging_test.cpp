@@ -280,6 +280,12 @@ HeadCheck segmentAndCheck(const phantom::Phantom& p, const imaging::SegmentOptio
   return checkHead(p, label, s);
 }
 
+HeadCheck segmentLeftAndCheck(const phantom::Phantom& p, imaging::SegmentSummary& s) {
+  imaging::SegmentOptions so;
+  so.side = imaging::Side::Left;
+  return segmentAndCheck(p, so, s);
+}
+
 TEST(ImagingSegment, PhantomHeadMatchesTruthAcrossGapsSidesAndSpacings) {
   struct Case { double gap; bool right; Eigen::Vector3d spacing; };
   for (const Case& c : {Case{2.0, true, {0.7, 0.7, 1.5}}, Case{4.0, false, {0.7, 0.7, 1.5}},
@@ -440,10 +446,8 @@ TEST(ImagingSegment, LowDoseNoiseClosedAroundTheHeadIsCutOff) {
       clinicalHead(302, geometry::ShapeModel::Ellipsoid, 22, false, Eigen::Vector3d(0.8, 0.8, 1.5), 2.5);
   o.noise_hu = 100;
   const phantom::Phantom p = phantom::makePhantom(o);
-  imaging::SegmentOptions so;
-  so.side = imaging::Side::Left;
   imaging::SegmentSummary s;
-  const HeadCheck h = segmentAndCheck(p, so, s);
+  const HeadCheck h = segmentLeftAndCheck(p, s);
   EXPECT_EQ(s.head_found_by, "edges");
   EXPECT_GT(h.head_recall, 0.95);
   EXPECT_LT(h.socket_leak, 0.02);
@@ -503,10 +507,8 @@ TEST(ImagingSegment, ANoisySharpKernelScanIsSegmentedOnASmoothedCopy) {
   o.kernel = phantom::PhantomOptions::Kernel::Sharp;
   o.noise_hu = 100;
   const phantom::Phantom p = phantom::makePhantom(o);
-  imaging::SegmentOptions so;
-  so.side = imaging::Side::Left;
   imaging::SegmentSummary s;
-  const HeadCheck h = segmentAndCheck(p, so, s);
+  const HeadCheck h = segmentLeftAndCheck(p, s);
   EXPECT_GT(s.noise_hu, imaging::kSmoothSegmentationAboveNoiseHu);
   EXPECT_NEAR(s.smoothed_sigma_mm, 0.8, 1e-6);
   EXPECT_EQ(s.head_found_by, "edges");

@@ -131,6 +131,15 @@ QcCheck grade(const std::string& name, double value, double warn, std::optional<
   return c;
 }
 
+/// A check of what the data show (coverage, metal, noise, blur), not of
+/// the structure's identity: not counted among the structure's doubts, its
+/// reason followed by what it means for the result when it does not pass.
+QcCheck ofTheData(QcCheck check, const std::string& meaning) {
+  check.of_structure = false;
+  if (check.status != "pass") check.reason += meaning;
+  return check;
+}
+
 }  // namespace
 
 std::vector<std::string> QcReport::reasons() const {
@@ -365,42 +374,32 @@ QcReport checkHead(const HeadQcInput& in) {
   }
   if (in.cortex_contrast_across_slices) {
     // Of the surface's accuracy, not of the structure: it only warns.
-    QcCheck contrast = grade("cortex_contrast_across_slices", *in.cortex_contrast_across_slices, kSliceContrastWarn,
-                             std::nullopt, true,
-                             "the cortex is blurred away across the slices (its contrast over the cancellous bone "
-                             "there, relative to within a slice):");
-    contrast.of_structure = false;
-    if (contrast.status == "warn")
-      contrast.reason += ": where the normals cross the slices the surface lies outside the bone's, by up to the "
-                         "blur across the slices";
-    report.checks.push_back(contrast);
+    report.checks.push_back(ofTheData(
+        grade("cortex_contrast_across_slices", *in.cortex_contrast_across_slices, kSliceContrastWarn, std::nullopt, true,
+              "the cortex is blurred away across the slices (its contrast over the cancellous bone there, relative to "
+              "within a slice):"),
+        ": where the normals cross the slices the surface lies outside the bone's, by up to the blur across the slices"));
   }
   if (in.head_outside_volume_share) {
     // Of what the data covers, not of the structure: a clipped head is still the head.
-    QcCheck clipped = grade("head_outside_volume_share", *in.head_outside_volume_share, kOutsideWarn, kOutsideFail,
-                            false, "the field of view clips the head: the share of its sphere (the neck aside) outside the CT is");
-    clipped.of_structure = false;
-    if (clipped.status != "pass")
-      clipped.reason += ": the points cover only the part in view, and the fitted shape extrapolates the rest";
-    report.checks.push_back(clipped);
+    report.checks.push_back(ofTheData(
+        grade("head_outside_volume_share", *in.head_outside_volume_share, kOutsideWarn, kOutsideFail, false,
+              "the field of view clips the head: the share of its sphere (the neck aside) outside the CT is"),
+        ": the points cover only the part in view, and the fitted shape extrapolates the rest"));
   }
   if (in.metal_near_head_mm3) {
-    QcCheck metal = grade("metal_near_head_mm3", *in.metal_near_head_mm3, kMetalWarnMm3, std::nullopt, false,
-                          "metal near the head: the volume (mm^3) above " + number(imaging::kMetalHu) + " HU within " +
-                              number(kMetalReachRadii) + " radii of its centre is");
-    metal.of_structure = false;
-    if (metal.status == "warn")
-      metal.reason += ": its streaks and dark bands can move the bone's edges; check the head on the slices";
-    report.checks.push_back(metal);
+    report.checks.push_back(ofTheData(
+        grade("metal_near_head_mm3", *in.metal_near_head_mm3, kMetalWarnMm3, std::nullopt, false,
+              "metal near the head: the volume (mm^3) above " + number(imaging::kMetalHu) + " HU within " +
+                  number(kMetalReachRadii) + " radii of its centre is"),
+        ": its streaks and dark bands can move the bone's edges; check the head on the slices"));
   }
   if (in.ct_noise_hu) {
-    QcCheck noise = grade("ct_noise_hu", *in.ct_noise_hu, imaging::kSmoothSegmentationAboveNoiseHu, std::nullopt, false,
-                          "a noisy CT (a low dose or a sharp kernel): its noise voxel to voxel (HU) is");
-    noise.of_structure = false;
-    if (noise.status == "warn")
-      noise.reason += ": the head was searched and labelled on a smoothed copy, its surface placed on the noisy voxels; "
-                      "check the head on the slices";
-    report.checks.push_back(noise);
+    report.checks.push_back(ofTheData(
+        grade("ct_noise_hu", *in.ct_noise_hu, imaging::kSmoothSegmentationAboveNoiseHu, std::nullopt, false,
+              "a noisy CT (a low dose or a sharp kernel): its noise voxel to voxel (HU) is"),
+        ": the head was searched and labelled on a smoothed copy, its surface placed on the noisy voxels; check the "
+        "head on the slices"));
   }
   // Regions of the cap off the model (cap_departures.hpp) warn from
   // kDepartureWarnMm2 and are no doubt about the structure: the band of
