@@ -223,7 +223,9 @@ Label segmentHeadIn(const Volume& volume, const SegmentOptions& options, Segment
 Label segmentHead(const Volume& ct, const SegmentOptions& options, SegmentSummary* summary_out) {
   options.validate();
   SegmentSummary summary;
-  summary.noise_hu = noiseHu(ct);
+  // With an outside label the CT outside its bone is air: no soft tissue
+  // to measure (and its marrow's texture is no noise), so none is measured.
+  if (!options.one_bone) summary.noise_hu = noiseHu(ct);
   log::debug("the CT's noise voxel to voxel: " + std::to_string(summary.noise_hu) + " HU");
   // A noisy CT (low dose, a sharp kernel) is segmented on a copy smoothed by
   // an in-plane voxel: the label only has to hold the head, whose surface the

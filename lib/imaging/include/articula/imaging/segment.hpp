@@ -65,13 +65,15 @@ struct SegmentSummary {
   long long threshold_voxels = 0;           // voxels in the HU window (within the ROI)
   long long label_voxels = 0;
   long long cut_through_bone_voxels = 0;    // of label_voxels, those labelled kLabelCutThroughBone
-  double noise_hu = 0;                      // the CT's noise voxel to voxel (imaging/noise.hpp)
+  double noise_hu = 0;                      // the CT's noise voxel to voxel (imaging/noise.hpp; 0 with one_bone)
   double smoothed_sigma_mm = 0;             // the Gaussian the head was segmented after (0: none, the CT as read)
   std::vector<std::string> warnings;
 };
 
 /// Labels the joint head (with whatever of its neck the watershed keeps) in
 /// the volume's own grid: kLabelBone, or kLabelCutThroughBone on its cut.
+/// A CT noisier than kSmoothSegmentationAboveNoiseHu (imaging/noise.hpp) is
+/// searched and labelled on a copy smoothed by an in-plane voxel.
 /// Throws ProcessingError (exit 1) if no head is found and InputError if the
 /// window holds no voxel.
 Label segmentHead(const Volume& volume, const SegmentOptions& options, SegmentSummary* summary = nullptr);
