@@ -36,7 +36,7 @@ edges=()
 run low-dose --noise 60 --model sphere
 
 python3 - "$tmp" <<'PY'
-import json, math, struct, sys
+import json, math, re, struct, sys
 tmp = sys.argv[1]
 
 def checks(name):
@@ -73,5 +73,10 @@ within = sum(abs(x) <= 1.5 for x in d) / n
 print(f"low-dose: {n} points, RMS {rms:.3f} mm to the true sphere, {100 * within:.1f} % within 1.5 mm")
 assert open(f"{tmp}/low-dose.rc").read().strip() == "0"
 assert status("low-dose", "ct_noise_hu") == "warn"
+# The page's methods say the noisy CT was smoothed for the search and the label.
+def methods(name):
+    return re.search(r'<p id="methods">(.*?)</p>', open(f"{tmp}/run-{name}/report.html").read(), re.S).group(1)
+assert "HU voxel to voxel, was smoothed for the search and the label" in methods("low-dose"), methods("low-dose")
+assert "smoothed for the search" not in methods("plain"), methods("plain")
 assert n > 500 and rms <= 0.3 and within >= 0.95, (n, rms, within)
 PY

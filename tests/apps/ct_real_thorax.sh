@@ -33,6 +33,10 @@ print(f"thorax {side}: qc {qc['status']}: " + "; ".join(qc.get("reasons", [])))
 assert qc["status"] == "fail", qc["status"]
 if side == "right":
     assert checks["head_outside_volume_share"]["status"] == "fail", checks["head_outside_volume_share"]
+    # The search's fallback took this head: a named check, and the page's methods say so.
+    assert checks["head_found_by_edges"]["status"] == "warn", checks["head_found_by_edges"]
+    methods = re.search(r'<p id="methods">(.*?)</p>', open(sys.argv[1].replace("results.json", "report.html")).read(), re.S).group(1)
+    assert "the head taken by the search&#39;s fallback" in methods, methods
     assert checks["head_from_body_middle_mm"]["status"] == "pass", checks["head_from_body_middle_mm"]
 else:
     assert checks["head_from_body_middle_mm"]["status"] == "fail", checks["head_from_body_middle_mm"]

@@ -294,6 +294,12 @@ std::string methodsParagraph(const json& results, const fs::path& folder) {
     p << " at voxels of " << fixed(segment.at("spacing_mm")[0].get<double>(), 2) << " x "
       << fixed(segment.at("spacing_mm")[1].get<double>(), 2) << " x " << fixed(segment.at("spacing_mm")[2].get<double>(), 2)
       << " mm";
+  if (numberAt(segment, "smoothed_sigma_mm") > 0)
+    p << " (the CT's noise, " << fixed(numberAt(segment, "noise_hu"), 0) << " HU voxel to voxel, was smoothed for the "
+      << "search and the label by a Gaussian of " << fixed(numberAt(segment, "smoothed_sigma_mm"), 2) << " mm)";
+  if (text(segment, "head_found_by") == "surface voxels")
+    p << ", the head taken by the search's fallback (the bone surface voxels facing a centre: no sphere through its "
+         "edges)";
   p << "; its surface was extracted by marching cubes and smoothing";
   const json& edges = member(mesh, "ct_edges");
   if (member(edges, "moved") == true) {
