@@ -23,6 +23,9 @@ double medianOf(std::vector<float>& values) {
 
 }  // namespace
 
+// Hand-written: ITK's NoiseImageFilter gives each voxel its neighbourhood's
+// spread, which edges and texture swell; one robust figure for the whole CT
+// is the median's, over soft tissue only.
 double noiseHu(const Volume& volume) {
   const ImageGeometry& g = volume.geometry;
   const auto soft = [](float hu) { return hu >= kSoftTissueLowHu && hu <= kSoftTissueHighHu; };
