@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include <itkBinaryFillholeImageFilter.h>
@@ -230,7 +231,7 @@ Label segmentHead(const Volume& ct, const SegmentOptions& options, SegmentSummar
   // A noisy CT (low dose, a sharp kernel) is segmented on a copy smoothed by
   // an in-plane voxel: the label only has to hold the head, whose surface the
   // mesh stage places on the CT's own voxels.
-  Volume calm;
+  std::optional<Volume> calm;
   if (summary.noise_hu > kSmoothSegmentationAboveNoiseHu) {
     summary.smoothed_sigma_mm = std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]);
     calm = smoothed(ct, summary.smoothed_sigma_mm);
@@ -240,7 +241,7 @@ Label segmentHead(const Volume& ct, const SegmentOptions& options, SegmentSummar
       << "smoothed by a Gaussian of " << summary.smoothed_sigma_mm << " mm, its surface placed on the CT's own voxels";
     log::warn(m.str());  // the report's check ct_noise_hu says it too
   }
-  Label label = segmentHeadIn(summary.smoothed_sigma_mm > 0 ? calm : ct, options, summary);
+  Label label = segmentHeadIn(calm ? *calm : ct, options, summary);
   if (summary_out) *summary_out = summary;
   return label;
 }

@@ -129,7 +129,7 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
       for (const auto& w : seg.value("warnings", json::array()))
         if (w.is_string()) in.stage_warnings.push_back(w.get<std::string>());
       if (seg.contains("head_depth_mm")) in.label_depth_mm = seg.at("head_depth_mm").get<double>();
-      if (seg.contains("noise_hu") && seg.at("noise_hu").get<double>() > 0) in.ct_noise_hu = seg.at("noise_hu").get<double>();
+      if (const double noise_hu = seg.value("noise_hu", 0.0); noise_hu > 0) in.ct_noise_hu = noise_hu;
       // The head radii the user allowed the search (--min-radius,
       // --max-radius): a head found beyond the defaults with a widened range
       // is held to that range.
