@@ -4,12 +4,14 @@
 # 2.09 for seed 7): from the ellipsoid's axis labelling alone the
 # superellipsoid ended at 0.30 mm RMS and the run selected the superovoid
 # (a superellipsoid under another labelling). The run selects the
-# superellipsoid, which fits within 0.02 mm of the superovoid.
+# superellipsoid, which fits within 0.02 mm of the superovoid. The edges
+# on the steepest fall: the test is of the fit's start, and the
+# blurred-cortex model would double its time.
 # labels: full-size
 source "$(dirname "$0")/common.bash"
 for seed in 7 12; do
   "$bin/articula" phantom -o "$tmp/p$seed" --seed "$seed" --no-dicom -q
-  "$bin/articula" run -i "$tmp/p$seed/phantom.nii.gz" -o "$tmp/r$seed" -q
+  "$bin/articula" run -i "$tmp/p$seed/phantom.nii.gz" -o "$tmp/r$seed" --edge-model steepest -q
   python3 - "$tmp/p$seed/truth.json" "$tmp/r$seed/results.json" <<'PY'
 import json, sys
 truth, r = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
