@@ -79,6 +79,8 @@ class MeshCommand : public cli::Command {
                {"point_spread_estimated", snapped.point_spread_estimated},
                {"point_spread_applied", snapped.point_spread_on_voxel_grid ? "voxel_grid" : "scanner"},
                {"cortex_held_across_slices", snapped.cortex_held_across_slices},
+               {"ct_noise_hu", snapped.ct_noise_hu},
+               {"line_radius_mm", snapped.line_radius_mm},
                {"vertices_on_cortex_model", snapped.on_cortex_model},
                {"mean_model_shift_mm", snapped.mean_model_shift_mm}};
       if (!snapped.cortex_model_note.empty()) {

@@ -41,6 +41,8 @@ def modes(head):
     out += [("contrast vessel", "", ["--contrast-vessel"]), ("table", "", ["--table"])]
     out += [("slice thickness", f"{thick:g} mm", ["--slice-thickness", str(thick)])]
     out += [("low dose", f"noise {n} HU", ["--noise", str(n)]) for n in (60, 100)]
+    # A thin (osteoporotic) cortex is where noise pulls the cortex model's surface outwards.
+    out += [("low dose (thin cortex)", f"noise {n} HU", ["--osteoporotic", "--noise", str(n)]) for n in (60, 100)]
     return out
 
 
@@ -101,6 +103,13 @@ def fmt(v, spec=".2f"):
     return "" if v is None else format(v, spec)
 
 
+def signed_range(rows):
+    """The points' mean signed distances to the true surface (outside
+    positive), least to largest."""
+    values = [r["mean_signed_mm"] for r in rows if r.get("mean_signed_mm") is not None]
+    return f"{min(values):+.3f} to {max(values):+.3f}" if values else ""
+
+
 def summary(rows):
     """One row per mode and strength: counts of each verdict, and the checks
     that warned or failed (with how many cases)."""
@@ -109,7 +118,7 @@ def summary(rows):
         key = (r["mode"], r["strength"] if r["mode"] != "FOV cut" else r["strength"].split(" ", 1)[1])
         groups.setdefault(key, []).append(r)
     lines = ["| mode | strength | cases | right | right, flagged | wrong, flagged | refused | silently wrong | "
-             "checks that warned or failed (cases) |", "|---|---|---|---|---|---|---|---|---|"]
+             "points' mean signed (mm) | checks that warned or failed (cases) |", "|---|---|---|---|---|---|---|---|---|---|"]
     for (mode, strength), g in groups.items():
         count = collections.Counter(f.split(" (")[0] for r in g for f in r["flags"])
         named = ", ".join(f"{k} ({v})" for k, v in sorted(count.items(), key=lambda kv: -kv[1]))
@@ -117,7 +126,7 @@ def summary(rows):
         right_clean = sum(r["verdict"] == "right" for r in g) - right_flagged
         lines.append(f"| {mode} | {strength} | {len(g)} | {right_clean} | {right_flagged} | "
                      f"{sum(r['verdict'] == 'flagged' for r in g)} | {sum(r['verdict'] == 'refused' for r in g)} | "
-                     f"{sum(r['verdict'] == 'SILENTLY WRONG' for r in g)} | {named} |")
+                     f"{sum(r['verdict'] == 'SILENTLY WRONG' for r in g)} | {signed_range(g)} | {named} |")
     return "\n".join(lines)
 
 
@@ -154,8 +163,8 @@ def fov_table(rows, check):
 
 def cases_table(rows, only_notable=False):
     lines = ["| case | head | spacing (mm) | mode | strength | verdict | exit | RMS (mm) | within 1.5 mm | "
-             "centre error (mm) | to the model: RMS (mm) | checks that warned or failed; message |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "mean signed (mm) | centre error (mm) | to the model: RMS (mm) | checks that warned or failed; message |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if only_notable and r["verdict"] == "right":
             continue
@@ -163,7 +172,7 @@ def cases_table(rows, only_notable=False):
         note = "; ".join(r["flags"]) if r["exit"] == 0 else r["message"]
         lines.append(f"| {r['id']} | {r['head']} ({r['model']}, {r['radius']} mm, {r['side']}) | {r['spacing']} | "
                      f"{r['mode']} | {r['strength']} | {r['verdict']} | {r['exit']} | {fmt(r.get('rms_mm'), '.3f')} | "
-                     f"{within} | {fmt(r.get('centre_error_mm'))} | {fmt(r.get('model_rms_mm'), '.3f')} | {note} |")
+                     f"{within} | {fmt(r.get('mean_signed_mm'), '+.3f')} | {fmt(r.get('centre_error_mm'))} | {fmt(r.get('model_rms_mm'), '.3f')} | {note} |")
     return "\n".join(lines)
 
 

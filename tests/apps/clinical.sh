@@ -79,4 +79,9 @@ def methods(name):
 assert "HU voxel to voxel, was smoothed for the search and the label" in methods("low-dose"), methods("low-dose")
 assert "smoothed for the search" not in methods("plain"), methods("plain")
 assert n > 500 and rms <= 0.3 and within >= 0.95, (n, rms, within)
+# The mesh stage measured the noise too; at 1.5 x 1.5 x 2 mm voxels its lines
+# already hold enough voxels for it (widened only below 3 mm of radius).
+edges = json.load(open(f"{tmp}/run-low-dose/bone.vtp.json"))["ct_edges"]
+assert abs(edges["ct_noise_hu"] - 60) < 6, edges
+assert abs(edges["line_radius_mm"] - math.sqrt(50 * 1.5 * 1.5 * 2 / (math.pi * 6))) < 1e-6, edges
 PY

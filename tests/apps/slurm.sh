@@ -87,7 +87,7 @@ sinfo -h -o %t | grep -q idle || { tail "$cluster"/*.log >&2; fail "the test clu
 # scheduler): the left hip of both, and a CT cut short (its segment stage
 # fails). Each stage job spends about 2 s of CPU in Snakemake's own start on
 # this machine's 2 cores, so a third subject would cost a third more.
-"$bin/articula" phantom -o "$tmp/p3" --seed 3 --spacing 1.5,1.5,2 --both-hips --side left --no-dicom --quiet
+"$bin/articula" phantom -o "$tmp/p3" --seed 3 --spacing 1.5,1.5,2 --side left --no-dicom --quiet
 head -c 20000 "$tmp/p3/phantom.nii.gz" > "$tmp/cut.nii.gz"
 cat > "$tmp/study.csv" <<CSV
 subject,input,joint,side,edge_model

@@ -113,8 +113,10 @@ struct FlatCortex {
 
 /// Lines across the plane at many places, each started on the steepest
 /// fall as the mesh stage starts them (`starts`: that fall's offset), with
-/// the mesh stage's window and radius for the line's direction.
-std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed, std::vector<double>& starts) {
+/// the mesh stage's window and radius for the line's direction (and the
+/// CT's noise, `noise_hu`).
+std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed, std::vector<double>& starts,
+                                             double noise_hu = 0) {
   const imaging::Volume v = c.volume(seed);
   const Eigen::Vector3d u = c.n;
   std::vector<imaging::LineVoxels> lines;
@@ -128,7 +130,7 @@ std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed,
       const Eigen::Vector3d axis_step = v.geometry.spacing.cwiseProduct(u);
       const double further_in = imaging::cortexSearchMm(axis_step) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
       lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm - further_in,
-                                               imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry, u)));
+                                               imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry, u, noise_hu)));
     }
   return lines;
 }
@@ -155,9 +157,9 @@ struct Estimate {
 
 /// The point-spread estimated over lines across the plane; each line's
 /// surface by the model with it.
-Estimate measure(const FlatCortex& c, unsigned seed) {
+Estimate measure(const FlatCortex& c, unsigned seed, double noise_hu = 0) {
   std::vector<double> starts;
-  const std::vector<imaging::LineVoxels> lines = linesAcross(c, seed, starts);
+  const std::vector<imaging::LineVoxels> lines = linesAcross(c, seed, starts, noise_hu);
   Estimate e;
   e.spread = imaging::estimatePointSpread(lines);
   for (const double start : starts) e.mean_steepest += start / static_cast<double>(starts.size());
@@ -174,6 +176,23 @@ TEST(CortexEdge, PointSpreadAndSurfaceOfAThinCortexFromTheCtAlone) {
   EXPECT_GT(e.found, 250);
   EXPECT_GT(e.mean_steepest - 0.0, 0.12);  // the steepest fall's outward pull ...
   EXPECT_NEAR(e.mean_model, 0.0, 0.05);    // ... which the model does not have
+}
+
+// Under low-dose noise (100 HU voxel to voxel) the fit of a line of a quiet
+// CT's voxels reads the thin cortex thicker and the point-spread narrower,
+// and puts the surface outside the bone; lines widened for the CT's noise
+// (lineRadiusFor's noise_hu) hold as many more voxels as the noise's
+// variance is larger, and read both as on a quiet CT.
+TEST(CortexEdge, LinesWidenedForLowDoseNoise) {
+  FlatCortex noisy;
+  noisy.noise = 100;
+  const Estimate quiet = measure(noisy, 7);
+  const Estimate widened = measure(noisy, 7, noisy.noise);
+  ASSERT_TRUE(quiet.spread.found && widened.spread.found);
+  EXPECT_GT(quiet.mean_model, 0.1);  // 0.19 mm outside, the point-spread 0.46 mm
+  EXPECT_NEAR(widened.spread.sigma_mm, noisy.sigma, 0.05);
+  EXPECT_NEAR(widened.mean_model, 0.0, 0.05);
+  EXPECT_GT(widened.found, 250);
 }
 
 // The same cortex blurred on the voxel grid at 0.8 mm voxels: the grid's

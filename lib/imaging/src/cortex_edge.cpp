@@ -325,14 +325,18 @@ double cortexSearchMm(const Eigen::Vector3d& axis_step_mm) {
   return std::max(kSearchMm, 0.75 * axis_step_mm.norm());
 }
 
-double lineRadiusFor(const ImageGeometry& geometry) {
+double lineRadiusFor(const ImageGeometry& geometry, double noise_hu) {
   constexpr double kVoxels = 50;
   const double voxel_volume = geometry.spacing.prod();
-  return std::max(0.8, std::sqrt(kVoxels * voxel_volume / (M_PI * (kCortexInwardMm + kCortexOutwardMm))));
+  const double quiet = std::max(0.8, std::sqrt(kVoxels * voxel_volume / (M_PI * (kCortexInwardMm + kCortexOutwardMm))));
+  // The voxels' count grows with the radius squared, the noise's variance
+  // with the noise squared.
+  if (!(noise_hu > kQuietCtNoiseHu)) return quiet;
+  return std::max(quiet, std::min(quiet * std::min(noise_hu / kQuietCtNoiseHu, kMaxNoiseWidening), kMaxNoisyLineRadiusMm));
 }
 
-double lineRadiusFor(const ImageGeometry& geometry, const Eigen::Vector3d& u) {
-  const double radius = lineRadiusFor(geometry);
+double lineRadiusFor(const ImageGeometry& geometry, const Eigen::Vector3d& u, double noise_hu) {
+  const double radius = lineRadiusFor(geometry, noise_hu);
   if (!tissueHeldAcrossSlices(geometry.spacing)) return radius;
   // A slice met at angle theta from its axis spreads its voxels within the
   // radius r over 2 r sin(theta) of depth; one slice's reach along the line

@@ -34,6 +34,7 @@
 #include "articula/core/parallel.hpp"
 #include "articula/imaging/cortex_edge.hpp"
 #include "articula/imaging/edges.hpp"
+#include "articula/imaging/noise.hpp"
 #include "articula/points/mesh_file.hpp"
 #include "articula/points/vtk_mesh.hpp"
 
@@ -505,7 +506,8 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     const double further_in = imaging::cortexSearchMm(axis_step) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
     return imaging::voxelsAboutLine(ct, on_falls.vertices.row(v).transpose(), n, -imaging::kCortexInwardMm - further_in,
                                     imaging::kCortexOutwardMm,
-                                    covering ? imaging::lineRadiusFor(ct.geometry, n) : imaging::lineRadiusFor(ct.geometry),
+                                    covering ? imaging::lineRadiusFor(ct.geometry, n, s.ct_noise_hu)
+                                             : imaging::lineRadiusFor(ct.geometry, s.ct_noise_hu),
                                     curvature[static_cast<size_t>(v)]);
   };
   std::vector<Eigen::Index> on_edge;
@@ -653,6 +655,10 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
        std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]) <= kCortexModelMaxInPlaneMm + 1e-6 &&
        ct.geometry.spacing[2] <= kCortexModelMaxSliceMm + 1e-6);
   const bool long_slices = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
+  if (cortex_model) {
+    s.ct_noise_hu = imaging::noiseHu(ct);
+    s.line_radius_mm = imaging::lineRadiusFor(ct.geometry, s.ct_noise_hu);
+  }
   for (Eigen::Index v = 0; v < n; ++v) {
     imaging::EdgeSearch along = search;
     if (cortex_model && long_slices && options.search_mm <= 0) {

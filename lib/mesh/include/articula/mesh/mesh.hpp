@@ -100,6 +100,8 @@ struct EdgeSnapSummary {
   bool point_spread_estimated = false;
   bool point_spread_on_voxel_grid = false;  // the blur was an image filter's on the voxels (imaging::PointSpread::Kind)
   bool cortex_held_across_slices = false;   // the lines across the slices held the cortex of the lines within them
+  double ct_noise_hu = 0;                   // the CT's noise voxel to voxel (imaging::noiseHu), which widens the model's lines
+  double line_radius_mm = 0;                // the model's lines' radius within the slices (imaging::lineRadiusFor)
   long long on_cortex_model = 0;
   double mean_model_shift_mm = 0;
   std::string cortex_model_note;  // why the model was not used, when it was asked for
