@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Clinical failure modes: `articula run` on 6 phantom heads (the five
 # models; radii 18-28 mm; right and left; 0.6 x 0.6 x 1 to 1 x 1 x 3 mm
-# voxels; one in a both-hips pelvis CT) x 41 cases of what clinical CT adds:
+# voxels; one in a both-hips pelvis CT) x 43 cases of what clinical CT adds:
 # none; a flattened dome (0.1, 0.25 of the radius); osteophytes (1.5, 3 mm);
 # cysts; a narrowed joint (0.8, 0.5 mm); the field of view cut at 0, 10, 25
 # and 50 % of the radius from each of the six faces; a screw in the neck, a
 # stem in the shaft; soft and sharp kernels; a contrast vessel; the table;
 # slices twice as thick as their spacing (at most 5 mm); low dose (noise 60
-# and 100 HU). Each case is right (the articular points' RMS to the true
+# and 100 HU), also over an osteoporotic head's thin cortex. Each case is right (the articular points' RMS to the true
 # surface <= half the in-plane voxel and >= 95 % within 1.5 mm), flagged (not
 # right, a check of the head warned or failed, named), refused (exit != 0,
 # with its reason) or SILENTLY WRONG (not right, no such check). Prints

@@ -9,6 +9,9 @@
 # submits nothing, and the cluster is stopped whatever happens.
 # Skipped (exit 77) without Slurm's and munge's programs, Snakemake, or root.
 # labels: scheduler
+# Alone: its jobs wait on the scheduler and on Snakemake's start in each job
+# (about 50 s of CPU over 36 s): beside another test it took 77 s.
+# run: alone
 source "$(dirname "$0")/common.bash"
 src=${ARTICULA_SOURCE:?}
 for program in munged slurmctld slurmd sbatch scontrol sinfo snakemake; do
