@@ -176,20 +176,26 @@ import json, sys
 check = next(c for c in json.load(open(sys.argv[1]))["qc"]["checks"] if c["name"] == "stage_warnings")
 assert check["status"] == "warn" and "mesh: the CT's point-spread could not be estimated" in check["reason"], check
 PY
-# So is the sample stage's: articular vertices on the label's cut through bone kept.
+# So is the sample stage's: articular vertices on the label's cut through
+# bone kept; two fifths of the points on the cut fail the head.
+cp "$tmp/r/points.ply.json" "$tmp/points.ply.json.kept"
 python3 - "$tmp/r/points.ply.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert d["cut_through_bone_kept"] == 0 and d["cut_through_bone_left_out"] >= 0, d
+d["cut_through_bone_kept"] = round(0.4 * d["selected_points"])
 d["warnings"] = ["60 of 150 articular vertices lie where the label ends inside bone (no edge in the CT), and without them fewer than 100 would remain: all are kept"]
 json.dump(d, open(sys.argv[1], "w"), indent=2)
 PY
-expect_rc 0 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
+expect_rc 1 "$bin/articula-report" -i "$tmp/r" --ct "$ct" --force
+grep -q "articular points lie where the label was cut" "$tmp/err" || fail "the report's failure: $(cat "$tmp/err")"
 python3 - "$tmp/r/results.json" <<'PY'
 import json, sys
-check = next(c for c in json.load(open(sys.argv[1]))["qc"]["checks"] if c["name"] == "stage_warnings")
-assert "sample: 60 of 150 articular vertices lie where the label ends inside bone" in check["reason"], check
+checks = {c["name"]: c for c in json.load(open(sys.argv[1]))["qc"]["checks"]}
+assert "sample: 60 of 150 articular vertices lie where the label ends inside bone" in checks["stage_warnings"]["reason"], checks
+assert checks["articular_points_on_cut"]["status"] == "fail" and abs(checks["articular_points_on_cut"]["value"] - 0.4) < 0.01, checks
 PY
+mv "$tmp/points.ply.json.kept" "$tmp/r/points.ply.json"
 
 # The segmentation's label marks its cut through bone (its sidecar counts
 # the voxels), and the mesh stage carries the marks onto the surface; a

@@ -281,6 +281,22 @@ TEST(HeadQc, ANoisyCtWarnsByItsOwnNameAndIsNoDoubtOfThePoints) {
   EXPECT_EQ(check(checks::checkHead(in), "ct_noise_hu").status, "pass");
 }
 
+TEST(HeadQc, ArticularPointsOnTheLabelsCutWarnAndMostlySoFail) {
+  // The sample stage kept 1,665 of 1,677 points on the label's cut (an
+  // osteoporotic head merged with its socket at 2.5 mm slices): they lie on
+  // the cut, 3 mm outside the bone, where a correct cap keeps none.
+  checks::HeadQcInput in = cap(23, 85);
+  in.points_on_cut_share = 0.0;
+  EXPECT_EQ(check(checks::checkHead(in), "articular_points_on_cut").status, "pass");
+  in.points_on_cut_share = 0.1;
+  EXPECT_EQ(check(checks::checkHead(in), "articular_points_on_cut").status, "warn");
+  in.points_on_cut_share = 1665.0 / 1677.0;
+  const checks::QcReport r = checks::checkHead(in);
+  EXPECT_EQ(check(r, "articular_points_on_cut").status, "fail");
+  EXPECT_NE(check(r, "articular_points_on_cut").reason.find("the segmentation's cut, not the head's"), std::string::npos);
+  EXPECT_EQ(r.status, "fail");
+}
+
 TEST(HeadQc, TheSurfaceRunIntoBoneBeyondWarnsByItsOwnNameAndIsNoDoubtOfThePoints) {
   // A departure of the bone and a region with bone beyond it, each over
   // 395 mm^2 (the socket's roof a thick-sliced phantom head's pole took).

@@ -119,9 +119,14 @@ checks::QcReport checkSubjectHead(const fs::path& folder, const points::PointClo
       in.stage_warnings.push_back("mesh: " + edges.at("cortex_model_note").get<std::string>());
   }
   const fs::path sample_summary = folder / "points.ply.json";
-  if (fs::exists(sample_summary))
-    for (const auto& w : readStageJson(sample_summary).value("warnings", json::array()))
+  if (fs::exists(sample_summary)) {
+    const json sample = readStageJson(sample_summary);
+    for (const auto& w : sample.value("warnings", json::array()))
       if (w.is_string()) in.stage_warnings.push_back("sample: " + w.get<std::string>());
+    const json kept = sample.value("cut_through_bone_kept", json());
+    const double selected = sample.value("selected_points", 0.0);
+    if (kept.is_number() && selected > 0) in.points_on_cut_share = kept.get<double>() / selected;
+  }
   const fs::path segment_summary = folder / "label.nii.gz.json";
   if (fs::exists(segment_summary)) {
     const json seg = readStageJson(segment_summary);

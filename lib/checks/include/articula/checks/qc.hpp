@@ -55,6 +55,7 @@ struct HeadQcInput {
   std::optional<double> cap_bone_beyond_mm2;     // CapDepartures::largestBoneBeyondMm2, where the mesh was given
   std::vector<std::string> stage_warnings;       // what the stages warned of (the segmentation's summary: reading, search)
   std::optional<bool> surface_on_ct_edges;       // the mesh stage moved the surface onto the CT's edges (else the label's staircase)
+  std::optional<double> points_on_cut_share;     // the sample stage's articular points kept on the label's cut (no bone edge), of all
   std::string joint;                             // "hip" or "shoulder", for the head's distance from the body's middle
   std::optional<double> body_middle_x_mm;        // the search's body middle (LPS x), if it judged the side by one
   double min_radius_mm = 15, max_radius_mm = 35;  // plausible joint heads
