@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "articula/core/error.hpp"
 #include "articula/geometry/fibonacci.hpp"
@@ -134,13 +135,19 @@ QcCheck grade(const std::string& name, double value, double warn, std::optional<
   return c;
 }
 
-/// A check of what the data show (coverage, metal, noise, blur), not of
-/// the structure's identity: not counted among the structure's doubts, its
-/// reason followed by what it means for the result when it does not pass.
-QcCheck ofTheData(QcCheck check, const std::string& meaning) {
-  check.of_structure = false;
+/// `check` with its reason followed by what it means for the result, when
+/// it does not pass.
+QcCheck explained(QcCheck check, const std::string& meaning) {
   if (check.status != "pass") check.reason += meaning;
   return check;
+}
+
+/// A check of what the data show (coverage, metal, noise, blur), not of
+/// the structure's identity: not counted among the structure's doubts, its
+/// reason explained.
+QcCheck ofTheData(QcCheck check, const std::string& meaning) {
+  check.of_structure = false;
+  return explained(std::move(check), meaning);
 }
 
 }  // namespace
@@ -346,12 +353,10 @@ QcReport checkHead(const HeadQcInput& in) {
   }
   if (in.joint_space_mm) {
     // Of the joint, not of the structure: a narrowed space is a finding.
-    QcCheck space = grade("joint_space_mm", *in.joint_space_mm, kJointSpaceWarnMm, std::nullopt, true,
-                          "the joint space (median, from the head's edge to the socket's across the gap, mm) is only");
-    space.of_structure = false;
-    if (space.status == "warn")
-      space.reason += ": a narrowed joint (adult hips: 3-5 mm), or the socket's edge taken into the head; check the slices";
-    report.checks.push_back(space);
+    report.checks.push_back(
+        ofTheData(grade("joint_space_mm", *in.joint_space_mm, kJointSpaceWarnMm, std::nullopt, true,
+                        "the joint space (median, from the head's edge to the socket's across the gap, mm) is only"),
+                  ": a narrowed joint (adult hips: 3-5 mm), or the socket's edge taken into the head; check the slices"));
   }
   if (in.socket_facing_share)
     report.checks.push_back(grade("socket_facing_share", *in.socket_facing_share, kSocketFacingWarn, kSocketFacingFail,
@@ -408,10 +413,7 @@ QcReport checkHead(const HeadQcInput& in) {
   // kDepartureWarnMm2 and are no doubt about the structure: the band of
   // points the fit takes leaves them out.
   const auto capRegions = [](const std::string& name, double area_mm2, const std::string& what, const std::string& why) {
-    QcCheck check = grade(name, area_mm2, kDepartureWarnMm2, std::nullopt, false, what);
-    check.of_structure = false;
-    if (check.status == "warn") check.reason += why;
-    return check;
+    return ofTheData(grade(name, area_mm2, kDepartureWarnMm2, std::nullopt, false, what), why);
   };
   // A finding of the bone (a flattened dome, an osteophyte); also where the
   // surface is off the bone (a slice too many at thick slices; a narrowed
@@ -451,14 +453,12 @@ QcReport checkHead(const HeadQcInput& in) {
     // (an osteoporotic head at 0.9 x 0.9 x 2.5 mm under 60 HU of noise: 99 %
     // of its points, 3 mm outside the bone). No correct head of the
     // benches' 2,300 runs kept one.
-    report.checks.push_back(grade("articular_points_on_cut", *in.points_on_cut_share, kPointsOnCutWarn,
-                                  kPointsOnCutFail, false,
-                                  "the articular points lie where the label was cut from a neighbouring bone (no "
-                                  "bone edge in the CT there): their share is"));
-    if (report.checks.back().status != "pass")
-      report.checks.back().reason +=
-          ": the surface there is the segmentation's cut, not the head's (a joint gap the CT does not resolve); "
-          "check the head on the slices, or give a label (--label)";
+    report.checks.push_back(explained(
+        grade("articular_points_on_cut", *in.points_on_cut_share, kPointsOnCutWarn, kPointsOnCutFail, false,
+              "the articular points lie where the label was cut from a neighbouring bone (no bone edge in the CT "
+              "there): their share is"),
+        ": the surface there is the segmentation's cut, not the head's (a joint gap the CT does not resolve); check "
+        "the head on the slices, or give a label (--label)"));
   }
   {
     // Every warning of a stage is a named check, never a terminal line only.
@@ -509,15 +509,13 @@ QcReport checkHead(const HeadQcInput& in) {
              "socket clearly medial to the head): the joint in view was taken as the requested side"));
   if (in.head_beyond_fov_mm) {
     // Of what the data covers, not of the structure (as the share above).
-    QcCheck beyond = grade("head_beyond_fov_relative", *in.head_beyond_fov_mm / r, kBeyondFovWarn, std::nullopt, false,
-                           "the field of view ends inside the head's sphere: it reaches beyond the CT's last voxels, "
-                           "relative to its radius, by");
-    beyond.of_structure = false;
-    if (beyond.status == "warn")
-      beyond.reason += " (" + number(*in.head_beyond_fov_mm) +
-                       " mm; on the neck's side too): the points cover only the part in view, and the fitted shape "
-                       "extrapolates the rest";
-    report.checks.push_back(beyond);
+    report.checks.push_back(
+        ofTheData(grade("head_beyond_fov_relative", *in.head_beyond_fov_mm / r, kBeyondFovWarn, std::nullopt, false,
+                        "the field of view ends inside the head's sphere: it reaches beyond the CT's last voxels, "
+                        "relative to its radius, by"),
+                  " (" + number(*in.head_beyond_fov_mm) +
+                      " mm; on the neck's side too): the points cover only the part in view, and the fitted shape "
+                      "extrapolates the rest"));
   }
   // Doubts compound: two checks of the structure that each find the head
   // doubtful are two independent signs of a wrong structure (on the phantom matrix, the one
