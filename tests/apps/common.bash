@@ -6,6 +6,11 @@ bin=${ARTICULA_BIN:?}
 tmp=${ARTICULA_TMP:?}
 rm -rf "$tmp" && mkdir -p "$tmp"
 
+# The Python that scripts/install-deps.sh installs its packages into
+# (Debian's). A version manager's shim earlier on PATH would also be slower:
+# pyenv's takes about 0.4 s a call, and the scripts make 150 calls.
+python3() { /usr/bin/python3 "$@"; }
+
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 # expect_rc CODE command...: runs the command (stdout in $tmp/out, stderr in

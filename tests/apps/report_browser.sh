@@ -54,7 +54,7 @@ for run in "${ARTICULA_FIXTURES:?}/demo/demo/run" "$tmp/study/subjects/p1"; do
     { tail "$tmp/console.err" >&2; fail "chromium on $page"; }
   [ -s "$tmp/shot.png" ] || fail "no screenshot of $page"
   check_console "$tmp/console.err" "$page"
-  /usr/bin/env python3 - "$tmp/dom.html" "$run/results.json" "$tmp/shot.png" <<'PY'
+  python3 - "$tmp/dom.html" "$run/results.json" "$tmp/shot.png" <<'PY'
 import html, json, re, struct, sys, zlib
 dom = open(sys.argv[1]).read()
 results = json.load(open(sys.argv[2]))
@@ -138,7 +138,7 @@ printf 'subject,decision,note\np1,include,"checked, ""fine"""\n' > "$tmp/study/r
 "$bin/articula" batch "$tmp/study.csv" -o "$tmp/study" --gather-only --quiet 2> /dev/null || true
 browse "file://$tmp/study/study.html" --dump-dom > "$tmp/study-dom.html" 2> "$tmp/study-console.err"
 check_console "$tmp/study-console.err" study.html
-/usr/bin/env python3 - "$tmp/study-dom.html" "$tmp/study" <<'PY'
+python3 - "$tmp/study-dom.html" "$tmp/study" <<'PY'
 import html, os, re, sys, urllib.parse
 dom, study = open(sys.argv[1]).read(), sys.argv[2]
 saved = html.unescape(re.search(r'<textarea id="ratings-csv"[^>]*>(.*?)</textarea>', dom, re.S).group(1))

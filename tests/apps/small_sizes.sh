@@ -1,19 +1,20 @@
 #!/usr/bin/env bash
 # Every stage and the drivers end to end on a small CT (a coarse-voxel
 # phantom, 1.2 x 1.2 x 1.5 mm, seconds in a release build), so that
-# the sanitizer tier runs them all: run on the DICOM series; the stage
+# the sanitizer tier runs them all, on the phantom's DICOM series: the stage
 # programs chained by pipelines/run-subject.sh (the shell pipeline users
-# copy) on the NIfTI; a batch of two subjects, one failing. Each result is
-# checked against the phantom's truth, and the shell pipeline's against the
-# batch's subject run with the same settings: the same results.json apart
-# from provenance, the same stage outputs where they carry no timing. All
-# three put the edges on the steepest fall (a third of the blurred-cortex
-# model's time; that model, the default here, runs in the sphere fixture).
+# copy); a batch of two subjects, one failing, whose good subject goes
+# through `articula run`. Each result is checked against the phantom's
+# truth, and the shell pipeline's against the batch's subject run with the
+# same settings: the same results.json apart from provenance, the same stage
+# outputs where they carry no timing. Both put the edges on the steepest fall
+# (a third of the blurred-cortex model's time; that model, the default
+# here, runs in the sphere fixture).
 source "$(dirname "$0")/common.bash"
 src=${ARTICULA_SOURCE:?}
 
 "$bin/articula" phantom -o "$tmp/p" --seed 8 --model ovoid --spacing 1.2,1.2,1.5 --quiet
-ct="$tmp/p/phantom.nii.gz"
+ct="$tmp/p/dicom"
 
 # check_head RESULTS: the sphere's centre within 1 mm of the true head's,
 # the selected model's RMS under 0.3 mm, the checks passed or warned.
@@ -33,12 +34,7 @@ assert r["qc"]["status"] in ("pass", "warn"), r["qc"]
 PY
 }
 
-# The driver on the DICOM series.
-"$bin/articula" run -i "$tmp/p/dicom" -o "$tmp/run" --quiet --edge-model steepest
-check_head "$tmp/run/results.json"
-[ -s "$tmp/run/report.html" ] && [ -s "$tmp/run/scene.mrml" ] || fail "run wrote no report or scene"
-
-# The stage programs, chained by the shell pipeline on the NIfTI.
+# The stage programs, chained by the shell pipeline.
 s="$tmp/stages"
 ARTICULA_BIN="$bin" bash "$src/pipelines/run-subject.sh" "$ct" "$s" hip right steepest > "$tmp/script.log" 2>&1 ||
   { cat "$tmp/script.log" >&2; fail "run-subject.sh failed"; }
@@ -49,11 +45,13 @@ check_head "$s/results.json"
 # complete and right, the study tables written.
 cat > "$tmp/study.csv" <<CSV
 subject,input,joint,side,edge_model
-small,p/phantom.nii.gz,hip,right,steepest
+small,p/dicom,hip,right,steepest
 missing,p/nowhere.nii.gz,hip,right,steepest
 CSV
 expect_rc 1 "$bin/articula" batch "$tmp/study.csv" -o "$tmp/study" -j 2 --quiet
 check_head "$tmp/study/subjects/small/results.json"
+[ -s "$tmp/study/subjects/small/report.html" ] && [ -s "$tmp/study/subjects/small/scene.mrml" ] ||
+  fail "run wrote no report or scene"
 grep -q "^missing,failed,3," "$tmp/study/study_status.csv" || fail "the missing subject: $(cat "$tmp/study/study_status.csv")"
 [ "$(grep -c '^small,' "$tmp/study/study.csv")" -eq 5 ] || fail "study.csv: not one row per model"
 [ -s "$tmp/study/study.html" ] || fail "no study.html"

@@ -151,8 +151,9 @@ kill -9 "$killed"
 { wait "$killed"; } 2>/dev/null && fail "the killed run exited 0" || true
 expect_rc 0 "$bin/articula" run -i "$p/phantom.nii.gz" -o "$l" -q "${fast[@]}"
 [ -e "$l/results.json" ] || fail "the run after a killed one did not finish"
-# batch: one per study folder, the same way.
-mkdir -p "$tmp/busy/.articula"
+# batch: one per study folder, the same way (on a copy of b's finished
+# study, so that the batch that proceeds resumes its subject).
+cp -r "$b" "$tmp/busy"
 exec 9>>"$tmp/busy/.articula/lock"
 flock 9
 expect_rc 1 "$bin/articula" batch "$tmp/manifest.csv" -o "$tmp/busy" -q

@@ -264,10 +264,10 @@ TEST(FitHierarchy, TerminationTypeTellsConvergedRunsFromCutOnes) {
 }
 
 TEST(FitHierarchy, DeterministicForAFixedSeed) {
-  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Superovoid), 1.0, 800, 0.1, 4);
+  const Eigen::MatrixX3d pts = articula::fit::syntheticCap(trueShape(ShapeModel::Superovoid), 1.0, 400, 0.1, 4);
   Options o;
   o.strategy = articula::fit::Strategy::GlobalLocal;
-  o.global_evaluations = 300;
+  o.global_evaluations = 150;
   o.seed = 9;
   // The starts are screened over the threads: one thread or four, the same fits.
   o.threads = 1;
