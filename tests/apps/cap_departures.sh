@@ -17,11 +17,11 @@ source "$(dirname "$0")/common.bash"
 python3 - "$tmp" "${ARTICULA_FIXTURES:?}/sphere/run" <<'PY'
 import json, sys
 tmp, plain_run = sys.argv[1:]
-def read(shape):
-    results = json.load(open(f"{tmp}/{shape}/results.json" if shape == "flat" else f"{plain_run}/results.json"))
+def read(run):
+    results = json.load(open(f"{run}/results.json"))
     check = next(c for c in results["qc"]["checks"] if c["name"] == "cap_departure_mm2")
     return results["cap_departures"], check
-flat, flat_check = read("flat")
+flat, flat_check = read(f"{tmp}/flat")
 truth = json.load(open(f"{tmp}/flat-ct/truth.json"))["departures"][0]
 t, h = flat["threshold_mm"], truth["max_depth_mm"]
 expected = truth["area_mm2"] * (h - t) / h
@@ -32,7 +32,7 @@ assert dome["kind"] == "inward" and dome["where"].startswith("superior"), dome
 assert abs(dome["area_mm2"] - expected) < 0.15 * expected, (dome, expected)
 assert h - 0.2 < dome["depth_mm"] < h + 0.8, (dome, h)
 assert flat_check["status"] == "warn" and flat_check["value"] == dome["area_mm2"], flat_check
-plain, plain_check = read("plain")
+plain, plain_check = read(plain_run)
 print(f"plain: regions {[(r['kind'], round(r['area_mm2']), round(r['depth_mm'], 2)) for r in plain['regions']]}; "
       f"check {plain_check['status']}")
 assert plain_check["status"] == "pass" and all(r["depth_mm"] < 2 for r in plain["regions"]), plain

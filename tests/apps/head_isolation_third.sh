@@ -10,7 +10,7 @@
 source "$(dirname "$0")/common.bash"
 source "$(dirname "$0")/third_phantom.bash"
 
-"$py" "$gen" out="$tmp/shifted" joint=hip both=1 side=left seed=410 R=24 gap=2.5 air=0 fov=135,70,65 fov_shift=60,0,0 \
+python3 "$gen" out="$tmp/shifted" joint=hip both=1 side=left seed=410 R=24 gap=2.5 air=0 fov=135,70,65 fov_shift=60,0,0 \
   spacing=0.8,0.8,1.5 > /dev/null
 run shifted right
 [ "$rc" -eq 1 ] || fail "the right hip, out of view, was not refused (exit $rc): $(score "$tmp/shifted-right" "$tmp/shifted.json" right)"

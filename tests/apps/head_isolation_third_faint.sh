@@ -8,7 +8,7 @@
 source "$(dirname "$0")/common.bash"
 source "$(dirname "$0")/third_phantom.bash"
 
-"$py" "$gen" out="$tmp/faint" joint=hip side=left seed=109 R=21 gap=2 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 \
+python3 "$gen" out="$tmp/faint" joint=hip side=left seed=109 R=21 gap=2 cortex=0.6 cort_hu=500 trab_hu=100 tex=60 \
   spacing=0.8,0.8,1.25 noise=20 > /dev/null
 run faint left
 if [ "$rc" -eq 0 ]; then

@@ -2,13 +2,12 @@
 # (bench/third_phantom.py; sourced, not a test itself): the generator, a
 # score against its truth and a run that keeps its exit code. Skips the
 # test (77) without numpy and scipy.
-py=/usr/bin/python3  # Debian's, with python3-numpy and python3-scipy
-"$py" -c "import numpy, scipy" 2> /dev/null || { echo "no numpy/scipy: skipped"; exit 77; }
+python3 -c "import numpy, scipy" 2> /dev/null || { echo "no numpy/scipy: skipped"; exit 77; }
 gen="$ARTICULA_SOURCE/bench/third_phantom.py"
 
 # score RUN TRUTH SIDE: exit 0 when the run's articular points lie on the true head.
 score() {
-  "$py" - "$1" "$2" "$3" "$ARTICULA_SOURCE/bench" <<'PY'
+  python3 - "$1" "$2" "$3" "$ARTICULA_SOURCE/bench" <<'PY'
 import json, sys
 import numpy as np
 run, truth, side, bench = sys.argv[1:5]
