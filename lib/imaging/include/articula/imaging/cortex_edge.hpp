@@ -180,12 +180,16 @@ struct PointSpread {
 /// slices (their shares summing to less than a tenth of the lines) give one
 /// width for both.
 /// Where the slices are more than a fifth longer than the in-plane voxel
-/// (tissueHeldAcrossSlices), or the width across them comes out more than a
-/// tenth wider than within them, the width across the slices is then
-/// estimated again on the lines across them (slice share kWithinSlicesShare
-/// or more), each fitted with the tissue of its nearest lines within the
-/// slices (nearbyTissue): across long or thick slices a thin cortex's
-/// thickness trades against the blur, and the width with it (held_across).
+/// (tissueHeldAcrossSlices), the width within them is the one width of the
+/// lines within them (slice share below kWithinSlicesShare) instead, since
+/// the lines across long slices see the slice's own profile, which a
+/// generator or scanner may take unlike the model's box.
+/// There, or where the width across the slices comes out more than a tenth
+/// wider than within them, the width across the slices is then estimated
+/// again on the lines across them, each fitted with the tissue of its
+/// nearest lines within the slices (nearbyTissue): across long or thick
+/// slices a thin cortex's thickness trades against the blur, and the width
+/// with it (held_across).
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, int threads = 1);
 
 /// Lines whose slice share is below this lie within the slices: across
