@@ -37,7 +37,8 @@ namespace articula::imaging {
 /// s in [from_mm, to_mm] (u a unit vector pointing out of the bone): their
 /// offsets along the line from a surface through x of mean curvature
 /// `curvature_per_mm` (positive where convex; a voxel at a distance l from
-/// the line lies l^2 curvature / 2 further out than its s), and their values.
+/// the line lies l^2 curvature / 2 further out than its s, with l^2 taking
+/// the variance of the voxel's extent across the line too), and their values.
 struct LineVoxels {
   std::vector<double> offset_mm, value_hu;
   double box_variance_mm2 = 0;  // the voxel's extent along u, as a variance (partial volume)
