@@ -691,36 +691,33 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
   if (tissueHeldAcrossSlices(lines.front().spacing_mm) && within.size() >= static_cast<size_t>(kMinLines)) {
     const Common in_plane = commonWidth(within, ps.kind);
     if (in_plane.found) ps.sigma_mm = in_plane.width_mm;
-    ps.found = true;
-    ps.held_across = true;
-    ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
-    return ps;
+  } else {
+    // The slice width, then the width within the slices, each searched over
+    // [common / 2.5, common * 2.5] and refined; kept only when the two fit
+    // better than the one by more than the log of the voxels' count (the
+    // Bayesian information criterion for one width more), since a second
+    // width also fits the noise (0.516 / 0.479 mm for a phantom's isotropic 0.5).
+    const auto searched = [&](const auto& f, const auto& f_few) {
+      constexpr int kSamples = 15;
+      const double ratio = std::pow(kWidthRange * kWidthRange, 1.0 / (kSamples - 1));
+      std::vector<double> grid_mm;
+      for (double s = common / kWidthRange; s <= common * kWidthRange * 1.0001; s *= ratio) grid_mm.push_back(s);
+      const double best = grid_mm[leastBasin(grid_mm, f, f_few)];
+      return leastOfSmoothed(f, best - 0.05, best + 0.05, 0.01);
+    };
+    PointSpread split = ps;
+    const std::vector<size_t> few = thinned(every);
+    split.slice_sigma_mm = searched([&](double s) { return total(every, ps.kind, common, s); },
+                                    [&](double s) { return total(few, ps.kind, common, s); })
+                               .first;
+    const auto [in_plane, split_value] =
+        searched([&](double s) { return total(every, ps.kind, s, split.slice_sigma_mm); },
+                 [&](double s) { return total(few, ps.kind, s, split.slice_sigma_mm); });
+    split.sigma_mm = in_plane;
+    double voxels = 0;
+    for (const LineVoxels& line : lines) voxels += static_cast<double>(line.offset_mm.size());
+    if (chosen_value - split_value > std::log(voxels)) ps = split;
   }
-
-  // The slice width, then the width within the slices, each searched over
-  // [common / 2.5, common * 2.5] and refined; kept only when the two fit
-  // better than the one by more than the log of the voxels' count (the
-  // Bayesian information criterion for one width more), since a second
-  // width also fits the noise (0.516 / 0.479 mm for a phantom's isotropic 0.5).
-  const auto searched = [&](const auto& f, const auto& f_few) {
-    constexpr int kSamples = 15;
-    const double ratio = std::pow(kWidthRange * kWidthRange, 1.0 / (kSamples - 1));
-    std::vector<double> grid_mm;
-    for (double s = common / kWidthRange; s <= common * kWidthRange * 1.0001; s *= ratio) grid_mm.push_back(s);
-    const double best = grid_mm[leastBasin(grid_mm, f, f_few)];
-    return leastOfSmoothed(f, best - 0.05, best + 0.05, 0.01);
-  };
-  PointSpread split = ps;
-  const std::vector<size_t> few = thinned(every);
-  split.slice_sigma_mm = searched([&](double s) { return total(every, ps.kind, common, s); },
-                                  [&](double s) { return total(few, ps.kind, common, s); })
-                             .first;
-  const auto [in_plane, split_value] = searched([&](double s) { return total(every, ps.kind, s, split.slice_sigma_mm); },
-                                                [&](double s) { return total(few, ps.kind, s, split.slice_sigma_mm); });
-  split.sigma_mm = in_plane;
-  double voxels = 0;
-  for (const LineVoxels& line : lines) voxels += static_cast<double>(line.offset_mm.size());
-  if (chosen_value - split_value > std::log(voxels)) ps = split;
   ps.found = true;
   ps.held_across = tissueHeldAcrossSlices(lines.front().spacing_mm, ps.sigma_mm, ps.slice_sigma_mm);
   if (ps.held_across) ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
