@@ -79,6 +79,8 @@ class MeshCommand : public cli::Command {
                {"point_spread_estimated", snapped.point_spread_estimated},
                {"point_spread_applied", snapped.point_spread_on_voxel_grid ? "voxel_grid" : "scanner"},
                {"cortex_held_across_slices", snapped.cortex_held_across_slices},
+               {"slice_thickness_mm", snap.slice_thickness_mm > 0 ? snap.slice_thickness_mm
+                                                                  : ct->geometry.voxelExtent()[2]},
                {"ct_noise_hu", snapped.ct_noise_hu},
                {"line_radius_mm", snapped.line_radius_mm},
                {"vertices_on_cortex_model", snapped.on_cortex_model},
@@ -102,7 +104,8 @@ class MeshCommand : public cli::Command {
                              {"decimate", options.decimate}, {"largest_component", options.largest_component},
                              {"edge_search_mm", snap.search_mm}, {"edge_model", given.edge_model},
                              {"point_spread_mm", snap.point_spread_mm},
-                             {"slice_point_spread_mm", snap.slice_point_spread_mm}};
+                             {"slice_point_spread_mm", snap.slice_point_spread_mm},
+                             {"slice_thickness_mm", snap.slice_thickness_mm}};
     nlohmann::json summary = {{"input", input_.string()},       {"output", output_.string()},
                               {"label_voxels", s.label_voxels}, {"raw_triangles", s.raw_triangles},
                               {"triangles", s.triangles},       {"vertices", s.vertices},

@@ -102,6 +102,9 @@ class SegmentCommand : public cli::Command {
         {"slice_spacing_measured_mm", report.slice_spacing_mm},
         {"slice_spacing_spread_mm", report.slice_spacing_spread_mm},
         {"gantry_tilt_deg", report.gantry_tilt_deg},
+        {"slice_thickness_stated_mm", report.slice_thickness_mm > 0 ? nlohmann::json(report.slice_thickness_mm)
+                                                                     : nlohmann::json(nullptr)},
+        {"voxel_extent_mm", vec(g.voxelExtent())},
         {"hu_window", {options.hu_min, options.hu_max}},
         {"seed_source", s.seed_source},
         {"label", given.label.empty() ? nlohmann::json(nullptr) : nlohmann::json(given.label.string())},

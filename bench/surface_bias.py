@@ -127,9 +127,12 @@ def main():
             tag = f"{name}-{a:g}x{a:g}x{b:g}"
             ct, truth = make_phantom(gen, opts, (a, a, b), f"{ARGS.work}/phantoms/{tag}")
             run = f"{ARGS.work}/runs/{tag}"
+            # A NIfTI file holds no slice thickness: given as a user would.
+            thickness = json.load(open(truth)).get("slice_thickness_mm")
+            given = ["--slice-thickness", f"{thickness:g}"] if thickness else []
             t0 = time.time()
             r = subprocess.run([f"{ARGS.bin}/articula", "run", "-i", ct, "-o", run, "--joint", joint, "--side", side,
-                                "--threads", ARGS.threads, "--force", "-q", *shlex.split(ARGS.run_args)],
+                                "--threads", ARGS.threads, "--force", "-q", *given, *shlex.split(ARGS.run_args)],
                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
             row = dict(case=name, inplane=a, slice=b, exit=r.returncode, seconds=round(time.time() - t0, 1))
             if r.returncode == 0:

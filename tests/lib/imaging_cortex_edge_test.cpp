@@ -26,8 +26,10 @@ double Phi(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 /// it meet the voxels at every phase.
 struct FlatCortex {
   double soft = 40, cortical = 700, cancellous = 190, thickness = 0.8, sigma = 0.5, spacing = 0.7, noise = 20;
-  double slice_spacing = 0;  // along the grid's third axis (0: `spacing`)
-  int slice_samples = 0;     // a voxel's samples across the slice (0: as finely as within it)
+  double slice_spacing = 0;    // along the grid's third axis (0: `spacing`)
+  double slice_thickness = 0;  // what a voxel averages over across the slices (0: their spacing)
+  bool thickness_stated = true;  // the volume's geometry says so (a DICOM series' Slice Thickness)
+  int slice_samples = 0;       // a voxel's samples across the slice (0: as finely as within it)
   double surface = 0.23;
   Eigen::Vector3d n = Eigen::Vector3d(1, 0.21, -0.13).normalized();
   Eigen::Vector3i size = Eigen::Vector3i(24, 40, 40);  // voxels (the grid centred on the origin)
@@ -58,15 +60,18 @@ struct FlatCortex {
   Eigen::Vector3d spacings() const {
     return Eigen::Vector3d(spacing, spacing, slice_spacing > 0 ? slice_spacing : spacing);
   }
+  Eigen::Vector3d extents() const {
+    return Eigen::Vector3d(spacing, spacing, slice_thickness > 0 ? slice_thickness : spacings().z());
+  }
   /// A voxel: the blurred profile averaged over 5 x 5 x 5 points of it
   /// (partial volume; 5 x 5 x 15 across long slices, or `slice_samples`).
   double voxel(const Eigen::Vector3d& centre) const {
-    const int sub = 5, sub_z = slice_samples > 0 ? slice_samples : spacings().z() > 2 * spacing ? 15 : 5;
+    const int sub = 5, sub_z = slice_samples > 0 ? slice_samples : extents().z() > 2 * spacing ? 15 : 5;
     double sum = 0;
     for (int c = 0; c < sub * sub * sub_z; ++c) {
       const Eigen::Vector3d offset((c % sub + 0.5) / sub - 0.5, (c / sub % sub + 0.5) / sub - 0.5,
                                    (c / (sub * sub) + 0.5) / sub_z - 0.5);
-      sum += blurred(n.dot(centre + spacings().cwiseProduct(offset)) - surface);
+      sum += blurred(n.dot(centre + extents().cwiseProduct(offset)) - surface);
     }
     return sum / (sub * sub * sub_z);
   }
@@ -74,6 +79,7 @@ struct FlatCortex {
     imaging::Volume v;
     v.geometry.size = size;
     v.geometry.spacing = spacings();
+    if (thickness_stated) v.geometry.slice_thickness_mm = slice_thickness;
     v.geometry.origin = -0.5 * spacings().cwiseProduct(size.cast<double>() - Eigen::Vector3d::Ones());
     v.voxels.resize(static_cast<size_t>(v.geometry.voxelCount()));
     std::mt19937 rng(seed);
@@ -128,8 +134,8 @@ std::vector<imaging::LineVoxels> linesAcross(const FlatCortex& c, unsigned seed,
       const imaging::Edge edge = imaging::locateEdge(v, x0, u, {});
       if (!edge.found) continue;
       starts.push_back(edge.offset_mm);
-      const Eigen::Vector3d axis_step = v.geometry.spacing.cwiseProduct(u);
-      const double further_in = imaging::cortexSearchMm(axis_step) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
+      const Eigen::Vector3d axis_extent = v.geometry.voxelExtent().cwiseProduct(u);
+      const double further_in = imaging::cortexSearchMm(axis_extent) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
       lines.push_back(imaging::voxelsAboutLine(v, x0 + edge.offset_mm * u, u, -imaging::kCortexInwardMm - further_in,
                                                imaging::kCortexOutwardMm, imaging::lineRadiusFor(v.geometry, u, noise_hu)));
     }
@@ -417,6 +423,48 @@ TEST(CortexEdge, WidthWithinLongSlicesFromTheLinesWithinThem) {
   int found = 0;
   EXPECT_NEAR(meanModelSurface(within, within_starts, spread, found), 0.0, 0.05);
   EXPECT_GT(found, 250);
+}
+
+// Slices reconstructed twice as thick as their spacing (2 mm every 1 mm),
+// blurred on the grid as the phantom's are: each voxel averages the bone
+// over its thickness. Where the CT states it (a DICOM series' Slice
+// Thickness), the model's box across the slices is that thickness, and a
+// surface facing across them lies on the bone (0.003 mm); with the box
+// taken as the spacing, the wider profile puts it outside (0.073 mm).
+TEST(CortexEdge, SlicesThickerThanTheirSpacingAveragedOverTheirThickness) {
+  const auto heldSurface = [](bool stated) {
+    FlatCortex across;
+    across.spacing = 0.6;
+    across.slice_spacing = 1.0;
+    across.slice_thickness = 2.0;
+    across.thickness_stated = stated;
+    across.blur_on_grid = true;
+    across.n = Eigen::Vector3d(0.3, 0.1, 1).normalized();  // a slice share of 0.91
+    across.across1 = across.n.unitOrthogonal();
+    across.across2 = across.n.cross(across.across1);
+    across.size = Eigen::Vector3i(44, 44, 24);
+    std::vector<double> starts;
+    const std::vector<imaging::LineVoxels> lines = linesAcross(across, 43, starts);
+    imaging::PointSpread spread;
+    spread.sigma_mm = spread.slice_sigma_mm = across.sigma;
+    spread.kind = imaging::PointSpread::Kind::VoxelGrid;
+    imaging::CortexTissue tissue;
+    tissue.thickness_mm = across.thickness;
+    tissue.outside_hu = across.soft;
+    tissue.cortex_hu = across.cortical;
+    tissue.inside_hu = across.cancellous;
+    double sum = 0;
+    int found = 0;
+    for (size_t i = 0; i < lines.size(); ++i) {
+      const imaging::CortexFit held =
+          imaging::fitCortex(lines[i], 0.0, imaging::StepResponse(lines[i], spread), 150, &tissue);
+      if (held.found) sum += starts[i] + held.offset_mm, ++found;
+    }
+    EXPECT_GT(found, 100) << (stated ? "stated" : "not stated");
+    return sum / std::max(found, 1);
+  };
+  EXPECT_NEAR(heldSurface(true), 0.0, 0.05) << "the box the slices' thickness";
+  EXPECT_GT(heldSurface(false), 0.05) << "the box the slices' spacing";
 }
 
 TEST(CortexEdge, NothingFoundWithoutABrightLayerOrVoxels) {

@@ -117,6 +117,39 @@ TEST(ImagingIo, DicomSeriesRoundTripAndChecks) {
   std::filesystem::remove_all(dir);
 }
 
+// Slice Thickness (0018,0050) is what a voxel averages over across the
+// slices where it departs from their spacing; a thickness no reconstruction
+// gives (ten times the spacing) is named in a warning and left out.
+TEST(ImagingIo, DicomSliceThicknessIsTheVoxelsExtentAcrossTheSlices) {
+  phantom::Phantom p = smallPhantom(3, true);
+  ASSERT_NEAR(p.ct.geometry.spacing[2], 2.0, 1e-9);
+  const auto dir = testing::scratch("thickness");
+  const auto readWith = [&](double thickness, imaging::ReadReport& report) {
+    p.ct.geometry.slice_thickness_mm = thickness;
+    const auto folder = dir / ("t" + std::to_string(static_cast<int>(10 * thickness)));
+    imaging::writeDicomSeries(folder, p.ct, "test");
+    return imaging::readVolume(folder, {}, &report).geometry;
+  };
+  imaging::ReadReport report;
+  const imaging::ImageGeometry thick = readWith(3.0, report);
+  EXPECT_NEAR(report.slice_thickness_mm, 3.0, 1e-9);
+  EXPECT_NEAR(thick.slice_thickness_mm, 3.0, 1e-9);
+  EXPECT_NEAR(thick.voxelExtent()[2], 3.0, 1e-9);
+  EXPECT_NEAR(thick.voxelExtent()[0], thick.spacing[0], 1e-12);
+  EXPECT_TRUE(report.warnings.empty());
+
+  const imaging::ImageGeometry plain = readWith(0.0, report);  // the writer states the spacing
+  EXPECT_NEAR(report.slice_thickness_mm, 2.0, 1e-9);
+  EXPECT_EQ(plain.slice_thickness_mm, 0.0);
+  EXPECT_NEAR(plain.voxelExtent()[2], 2.0, 1e-9);
+
+  const imaging::ImageGeometry absurd = readWith(20.0, report);
+  EXPECT_EQ(absurd.slice_thickness_mm, 0.0);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("Slice Thickness (0018,0050) states 20 mm"), std::string::npos) << report.warnings[0];
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ImagingIo, BadFoldersAndFilesAreInputErrors) {
   const auto dir = testing::scratch("bad");
   EXPECT_THROW(imaging::readVolume(dir, {}), InputError);  // empty folder

@@ -62,7 +62,7 @@ TEST(StageOptions, EveryDefaultPassesItsOwnCheck) {
       if (text.empty() || option.type() == p::OptionType::Flag) continue;
       EXPECT_EQ(option.problem(valuesOf(option, text)), "") << stage.name << " --" << option.name;
     }
-  EXPECT_EQ(options, 45);
+  EXPECT_EQ(options, 46);
 }
 
 TEST(StageOptions, NamesAreUniqueAndSharedRunNamesAgree) {

@@ -321,8 +321,8 @@ size_t leastBasin(const std::vector<double>& grid, F f, G f_few) {
 
 }  // namespace
 
-double cortexSearchMm(const Eigen::Vector3d& axis_step_mm) {
-  return std::max(kSearchMm, 0.75 * axis_step_mm.norm());
+double cortexSearchMm(const Eigen::Vector3d& axis_extent_mm) {
+  return std::max(kSearchMm, 0.75 * axis_extent_mm.norm());
 }
 
 double lineRadiusFor(const ImageGeometry& geometry, double noise_hu) {
@@ -348,14 +348,16 @@ double lineRadiusFor(const ImageGeometry& geometry, const Eigen::Vector3d& u, do
 }
 
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
-                           double to_mm, double radius_mm, double curvature_per_mm) {
+                           double to_mm, double radius_mm, double curvature_per_mm, const Eigen::Vector3d& extent_mm) {
   const ImageGeometry& g = volume.geometry;
   LineVoxels line;
   line.spacing_mm = g.spacing;
+  line.extent_mm = extent_mm.isZero() ? g.voxelExtent() : extent_mm;
   line.point_mm = x;
   for (int a = 0; a < 3; ++a) {
     line.axis_step_mm[a] = g.spacing[a] * g.direction.col(a).dot(u);
-    line.box_variance_mm2 += line.axis_step_mm[a] * line.axis_step_mm[a] / 12.0;
+    line.axis_extent_mm[a] = line.extent_mm[a] * g.direction.col(a).dot(u);
+    line.box_variance_mm2 += line.axis_extent_mm[a] * line.axis_extent_mm[a] / 12.0;
   }
   const double across_slices = g.direction.col(2).dot(u);
   line.slice_share = across_slices * across_slices;
@@ -366,7 +368,7 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
   double lateral_box_variance_mm2 = 0;
   for (int a = 0; a < 3; ++a) {
     const double along = g.direction.col(a).dot(u);
-    lateral_box_variance_mm2 += g.spacing[a] * g.spacing[a] / 12.0 * (1 - along * along);
+    lateral_box_variance_mm2 += line.extent_mm[a] * line.extent_mm[a] / 12.0 * (1 - along * along);
   }
   // The index box around the segment, widened by the radius.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
@@ -428,7 +430,7 @@ StepResponse::StepResponse(const LineVoxels& line, const PointSpread& spread) {
   }
   // Each voxel's extent along the line: a box along each grid axis (partial volume).
   for (int a = 0; a < 3; ++a) {
-    const double extent = std::abs(line.axis_step_mm[a]);
+    const double extent = std::abs(line.axis_extent_mm[a]);
     if (extent >= kTableStepMm) density = boxOver(density, table_first_mm_, extent);
   }
   if (density.size() < 2) {  // no blur and no extent (a line made by hand): a sharp step
@@ -479,7 +481,7 @@ CortexFit fitCortex(const LineVoxels& whole_line, double guess_mm, const StepRes
   objective.held = held;
   // BOBYQA: two or three bounded parameters, a cheap smooth objective
   // without derivatives (the levels are solved inside it, variable projection).
-  const double search = cortexSearchMm(line.axis_step_mm);
+  const double search = cortexSearchMm(line.axis_extent_mm);
   const unsigned unknowns = held ? 2 : 3;
   nlopt::opt opt(nlopt::LN_BOBYQA, unknowns);
   if (held) {
@@ -515,12 +517,12 @@ CortexFit fitCortex(const LineVoxels& whole_line, double guess_mm, const StepRes
   return fit;
 }
 
-bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm) {
-  return spacing_mm[2] > kHeldAcrossSlicesRatio * std::max(spacing_mm[0], spacing_mm[1]);
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& extent_mm) {
+  return extent_mm[2] > kHeldAcrossSlicesRatio * std::max(extent_mm[0], extent_mm[1]);
 }
 
-bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm, double sigma_mm, double slice_sigma_mm) {
-  return tissueHeldAcrossSlices(spacing_mm) || slice_sigma_mm > kHeldAcrossBlurRatio * sigma_mm;
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& extent_mm, double sigma_mm, double slice_sigma_mm) {
+  return tissueHeldAcrossSlices(extent_mm) || slice_sigma_mm > kHeldAcrossBlurRatio * sigma_mm;
 }
 
 std::vector<CortexTissue> nearbyTissue(const std::vector<Eigen::Vector3d>& points,
@@ -688,7 +690,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
   // fitted with every line, the width within the slices came out short
   // (0.457 mm for 0.5, 0.468 for 0.6 at 0.6 x 0.6 x 3 mm) and the surface
   // outside by up to 0.2 mm. The lines within the slices tell it alone.
-  if (tissueHeldAcrossSlices(lines.front().spacing_mm) && within.size() >= static_cast<size_t>(kMinLines)) {
+  if (tissueHeldAcrossSlices(lines.front().extent_mm) && within.size() >= static_cast<size_t>(kMinLines)) {
     const Common in_plane = commonWidth(within, ps.kind);
     if (in_plane.found) ps.sigma_mm = in_plane.width_mm;
   } else {
@@ -719,7 +721,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
     if (chosen_value - split_value > std::log(voxels)) ps = split;
   }
   ps.found = true;
-  ps.held_across = tissueHeldAcrossSlices(lines.front().spacing_mm, ps.sigma_mm, ps.slice_sigma_mm);
+  ps.held_across = tissueHeldAcrossSlices(lines.front().extent_mm, ps.sigma_mm, ps.slice_sigma_mm);
   if (ps.held_across) ps.slice_sigma_mm = sliceWidthWithHeldTissue(ps, within, across);
   return ps;
 }

@@ -245,6 +245,7 @@ class Walker {
       case 0x00200032u: text = &header->position; break;
       case 0x00200037u: text = &header->orientation; break;
       case 0x00280030u: text = &header->pixel_spacing; break;
+      case 0x00180050u: text = &header->slice_thickness; break;
       case 0x00281053u: text = &header->rescale_slope; break;
       case 0x00280008u: text = &header->frames; break;
       case 0x0020000Eu: text = &header->series_uid; break;

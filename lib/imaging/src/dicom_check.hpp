@@ -25,7 +25,7 @@ enum class DicomFileKind {
 struct DicomSliceHeader {
   bool read = false;  // the data set was walked to its end
   bool bare = false;  // a data set without the preamble and meta header of a DICOM file
-  std::string position, orientation, pixel_spacing, rescale_slope, frames;  // DS/IS text
+  std::string position, orientation, pixel_spacing, rescale_slope, frames, slice_thickness;  // DS/IS text
   std::string series_uid, modality, description;
   long rows = -1, columns = -1, bits_allocated = -1, samples_per_pixel = -1;
   long bits_stored = -1, high_bit = -1, pixel_representation = -1;

@@ -335,6 +335,38 @@ void checkSlices(const std::vector<std::string>& files, const std::vector<DicomS
   spacing_out = std::fabs(median);
 }
 
+/// The thickness the slices state (Slice Thickness, 0018,0050): their median,
+/// 0 where none states one. Kept as the voxels' extent across the slices
+/// where it departs from the spacing by more than a per cent (slices
+/// reconstructed thicker than their spacing overlap; thinner ones leave
+/// gaps) and lies within a quarter to four times it; beyond, it is taken
+/// for a wrong tag and named in a warning.
+void readSliceThickness(const std::vector<DicomSliceHeader>& headers, double spacing_mm, ReadReport& report,
+                        ImageGeometry& geometry) {
+  std::vector<double> stated;
+  for (const DicomSliceHeader& h : headers) {
+    const std::vector<double> t = dicomNumbers(h.slice_thickness);
+    if (t.size() == 1 && t[0] > 0) stated.push_back(t[0]);
+  }
+  if (stated.empty()) return;
+  std::sort(stated.begin(), stated.end());
+  const double thickness = stated[stated.size() / 2];
+  report.slice_thickness_mm = thickness;
+  std::ostringstream m;
+  if (stated.back() > 1.01 * stated.front())
+    m << "the slices state thicknesses from " << stated.front() << " to " << stated.back() << " mm; their median "
+      << thickness << " mm is used";
+  if (std::fabs(thickness - spacing_mm) > 0.01 * spacing_mm) {
+    if (thickness >= 0.25 * spacing_mm && thickness <= 4 * spacing_mm) {
+      geometry.slice_thickness_mm = thickness;
+    } else {
+      m << (m.tellp() > 0 ? "; " : "") << "Slice Thickness (0018,0050) states " << thickness
+        << " mm against slices " << spacing_mm << " mm apart: not taken as the slices' extent";
+    }
+  }
+  if (m.tellp() > 0) report.warnings.push_back("DICOM series: " + m.str());
+}
+
 // Files of the folder in no series (no DICOM image): named in a warning
 // (the segmentation's summary keeps it), and in the message when the series
 // then lacks a slice.
@@ -401,6 +433,7 @@ Volume readDicom(const fs::path& folder, const ReadOptions& options, ReadReport&
   }
   Volume volume = fromItk<float>(reader->GetOutput());
   volume.geometry.spacing[2] = spacing_z;  // ITK uses the first two slices only
+  readSliceThickness(slices.headers, spacing_z, report, volume.geometry);
   return volume;
 }
 
@@ -702,7 +735,7 @@ void writeDicomSeries(const fs::path& folder, const Volume& volume, const std::s
     put("0020|0013", std::to_string(k + 1));
     put("0020|0032", num(p[0]) + "\\" + num(p[1]) + "\\" + num(p[2]));
     put("0020|0037", num(r[0]) + "\\" + num(r[1]) + "\\" + num(r[2]) + "\\" + num(c[0]) + "\\" + num(c[1]) + "\\" + num(c[2]));
-    put("0018|0050", num(g.spacing[2]));
+    put("0018|0050", num(g.voxelExtent()[2]));
     put("0028|0030", num(g.spacing[1]) + "\\" + num(g.spacing[0]));  // row spacing \ column spacing
     put("0028|0004", "MONOCHROME2");
     put("0028|1052", "0");

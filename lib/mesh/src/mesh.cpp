@@ -278,6 +278,8 @@ void EdgeSnapOptions::validate() const {
                      std::to_string(slice_point_spread_mm));
   if (slice_point_spread_mm > 0 && point_spread_mm <= 0)
     throw UsageError("slice point-spread: give the point-spread within the slices too (--point-spread)");
+  if (!(slice_thickness_mm >= 0 && slice_thickness_mm <= 20))
+    throw UsageError("slice thickness: expected 0 (the CT's) to 20 mm, found " + std::to_string(slice_thickness_mm));
 }
 
 namespace {
@@ -324,6 +326,14 @@ imaging::Edge boneEdge(const imaging::Volume& ct, const Eigen::Vector3d& x, cons
   for (double t = below.offset_mm + 0.5; t <= kBeyondLabelMm; t += 0.1)
     if (!(imaging::interpolate(ct, x + t * u) < middle)) return e;
   return below;
+}
+
+/// What one voxel averages over along each axis: the CT's (its slices'
+/// thickness where it states one), or the thickness the options give.
+Eigen::Vector3d voxelExtent(const imaging::Volume& ct, const EdgeSnapOptions& options) {
+  Eigen::Vector3d extent = ct.geometry.voxelExtent();
+  if (options.slice_thickness_mm > 0) extent[2] = options.slice_thickness_mm;
+  return extent;
 }
 
 /// Neighbour averages over the triangles' edges: the found shifts smoothed
@@ -493,7 +503,8 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   }
   on_falls.normals = fromVtk(withNormals(toVtk(on_falls))).normals;
   const double edge_mm = meanEdgeLength(on_falls, neighbours);
-  const double slices_mm = imaging::tissueHeldAcrossSlices(ct.geometry.spacing) ? ct.geometry.spacing[2] : 0.0;
+  const Eigen::Vector3d extent = voxelExtent(ct, options);
+  const double slices_mm = imaging::tissueHeldAcrossSlices(extent) ? extent[2] : 0.0;
   on_falls.normals = smoothedNormals(on_falls, neighbours, edge_mm, std::max(1.0, slices_mm));
   const std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm, std::max(2.0, 2 * slices_mm));
 
@@ -502,13 +513,13 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   // point-spread's estimate, which the wider lines' geometry would widen).
   const auto lineAt = [&](Eigen::Index v, bool covering) {
     const Eigen::Vector3d n = on_falls.normals.row(v).transpose();
-    const Eigen::Vector3d axis_step = ct.geometry.spacing.cwiseProduct(ct.geometry.direction.transpose() * n);
-    const double further_in = imaging::cortexSearchMm(axis_step) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
+    const Eigen::Vector3d axis_extent = extent.cwiseProduct(ct.geometry.direction.transpose() * n);
+    const double further_in = imaging::cortexSearchMm(axis_extent) - imaging::cortexSearchMm(Eigen::Vector3d::Zero());
     return imaging::voxelsAboutLine(ct, on_falls.vertices.row(v).transpose(), n, -imaging::kCortexInwardMm - further_in,
                                     imaging::kCortexOutwardMm,
                                     covering ? imaging::lineRadiusFor(ct.geometry, n, s.ct_noise_hu)
                                              : imaging::lineRadiusFor(ct.geometry, s.ct_noise_hu),
-                                    curvature[static_cast<size_t>(v)]);
+                                    curvature[static_cast<size_t>(v)], extent);
   };
   std::vector<Eigen::Index> on_edge;
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
@@ -529,7 +540,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     s.point_spread_estimated = true;
   }
   const bool held_across = s.point_spread_estimated ? spread.held_across
-                                                    : imaging::tissueHeldAcrossSlices(ct.geometry.spacing, spread.sigma_mm,
+                                                    : imaging::tissueHeldAcrossSlices(extent, spread.sigma_mm,
                                                                                       spread.slice_sigma_mm);
   const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
   std::vector<char> within(static_cast<size_t>(mesh.vertices.rows()), 1);
@@ -654,7 +665,8 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
       (options.edge_model == EdgeModel::Automatic &&
        std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]) <= kCortexModelMaxInPlaneMm + 1e-6 &&
        ct.geometry.spacing[2] <= kCortexModelMaxSliceMm + 1e-6);
-  const bool long_slices = imaging::tissueHeldAcrossSlices(ct.geometry.spacing);
+  const Eigen::Vector3d extent = voxelExtent(ct, options);
+  const bool long_slices = imaging::tissueHeldAcrossSlices(extent);
   if (cortex_model) {
     s.ct_noise_hu = imaging::noiseHu(ct);
     s.line_radius_mm = imaging::lineRadiusFor(ct.geometry, s.ct_noise_hu);
@@ -663,8 +675,8 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     imaging::EdgeSearch along = search;
     if (cortex_model && long_slices && options.search_mm <= 0) {
       const Eigen::Vector3d u = mesh.normals.row(v).transpose();
-      const double extent = ct.geometry.spacing.cwiseProduct(ct.geometry.direction.transpose() * u).norm();
-      along.smoothing_mm = std::max(std::max(0.15, 0.25 * ct.geometry.spacing.minCoeff()), 0.3 * extent);
+      const double reach = extent.cwiseProduct(ct.geometry.direction.transpose() * u).norm();
+      along.smoothing_mm = std::max(std::max(0.15, 0.25 * ct.geometry.spacing.minCoeff()), 0.3 * reach);
     }
     const imaging::Edge e =
         boneEdge(ct, mesh.vertices.row(v).transpose(), mesh.normals.row(v).transpose(), along, look_further);

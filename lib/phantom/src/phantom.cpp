@@ -613,6 +613,7 @@ Phantom makePhantom(const PhantomOptions& o) {
   out.neck_axis = out.hips[0].neck_axis;
   if (o.slice_thickness_mm > g.spacing[2]) {
     renderThickSlices(a, g, o.slice_thickness_mm, out.ct, out.femur);
+    out.ct.geometry.slice_thickness_mm = o.slice_thickness_mm;  // its DICOM states it
   } else {
     render(a, g, out.ct, out.femur);
   }

@@ -118,6 +118,11 @@ const std::map<std::string, std::vector<StageOption>>& declarations() {
                   "0: as within the slices)")
                .in(0, 3)
                .unitIs("mm"),
+           option("slice-thickness", FIELD(mesh().edges.slice_thickness_mm),
+                  "With --ct: what a voxel averages over across the slices, where the CT does not say (a NIfTI file "
+                  "holds no slice thickness; 0: a DICOM series' Slice Thickness, else the slices' spacing)")
+               .in(0, 20)
+               .unitIs("mm"),
        }},
       {"sample",
        {

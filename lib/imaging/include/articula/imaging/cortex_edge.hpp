@@ -43,12 +43,18 @@ struct LineVoxels {
   std::vector<double> offset_mm, value_hu;
   double box_variance_mm2 = 0;  // the voxel's extent along u, as a variance (partial volume)
   double slice_share = 0;       // (u . slice axis)^2: how far the line runs across the slices
-  Eigen::Vector3d spacing_mm = Eigen::Vector3d::Zero();    // the grid's, per axis
-  Eigen::Vector3d axis_step_mm = Eigen::Vector3d::Zero();  // how far along u one voxel's step along each grid axis goes
-  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();      // x: where the line's neighbours are sought
+  Eigen::Vector3d spacing_mm = Eigen::Vector3d::Zero();      // the grid's, per axis
+  Eigen::Vector3d extent_mm = Eigen::Vector3d::Zero();       // what a voxel averages over along each axis
+  Eigen::Vector3d axis_step_mm = Eigen::Vector3d::Zero();    // how far along u one voxel's step along each grid axis goes
+  Eigen::Vector3d axis_extent_mm = Eigen::Vector3d::Zero();  // ... and its extent along that axis
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();        // x: where the line's neighbours are sought
 };
+/// `extent_mm`: what one voxel averages over along each grid axis (zero:
+/// the volume's, ImageGeometry::voxelExtent; slices thicker than their
+/// spacing reach further than one step).
 LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const Eigen::Vector3d& u, double from_mm,
-                           double to_mm, double radius_mm, double curvature_per_mm = 0);
+                           double to_mm, double radius_mm, double curvature_per_mm = 0,
+                           const Eigen::Vector3d& extent_mm = Eigen::Vector3d::Zero());
 
 /// The window the model is fitted over: from kCortexInwardMm inside an edge
 /// (the cortex and some cancellous bone) to kCortexOutwardMm outside it (the
@@ -56,10 +62,10 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
 constexpr double kCortexInwardMm = 3.5, kCortexOutwardMm = 2.5;
 /// How far either side of its guess a line's surface is sought: a
 /// millimetre, or three quarters of the voxel's extent along the line
-/// where that is more (`axis_step_mm` as in LineVoxels): across 3 mm slices
+/// where that is more (`axis_extent_mm` as in LineVoxels): across 3 mm slices
 /// a thin cortex's steepest fall lies up to 1.5 mm outside it. A line's
 /// window reaches that much further in than kCortexInwardMm.
-double cortexSearchMm(const Eigen::Vector3d& axis_step_mm);
+double cortexSearchMm(const Eigen::Vector3d& axis_extent_mm);
 /// The radius about the line that holds about 50 voxels of the window (at
 /// least 0.8 mm): enough for the model's seven unknowns at any voxel size.
 /// On a CT noisier than kQuietCtNoiseHu voxel to voxel (`noise_hu`,
@@ -196,11 +202,12 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, int thread
 /// Lines whose slice share is below this lie within the slices: across
 /// them a line sees the in-plane voxel's extent and blur only.
 constexpr double kWithinSlicesShare = 0.05;
-/// Whether the voxels are long enough across the slices for the lines
-/// across them to take their tissue from the lines within them.
-bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm);
+/// Whether the voxels (their extent, ImageGeometry::voxelExtent) are long
+/// enough across the slices for the lines across them to take their tissue
+/// from the lines within them.
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& extent_mm);
 /// ... or whose point-spread is a tenth wider across the slices than within them.
-bool tissueHeldAcrossSlices(const Eigen::Vector3d& spacing_mm, double sigma_mm, double slice_sigma_mm);
+bool tissueHeldAcrossSlices(const Eigen::Vector3d& extent_mm, double sigma_mm, double slice_sigma_mm);
 /// For each of `points`, the median tissue of its nearest (15) `known`
 /// tissues (at `known_points`).
 std::vector<CortexTissue> nearbyTissue(const std::vector<Eigen::Vector3d>& points,

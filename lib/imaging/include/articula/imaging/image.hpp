@@ -17,7 +17,18 @@ struct ImageGeometry {
   Eigen::Vector3d spacing = Eigen::Vector3d::Ones();           // mm
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();            // LPS mm of voxel (0,0,0)
   Eigen::Matrix3d direction = Eigen::Matrix3d::Identity();     // columns: i, j, k axes in LPS
+  /// The slices' own extent along k where it is not their spacing (a DICOM
+  /// series' Slice Thickness, 0018,0050: slices reconstructed thicker than
+  /// their spacing overlap); 0: the spacing.
+  double slice_thickness_mm = 0;
 
+  /// What one voxel averages over along each axis: its spacing, and
+  /// across the slices their thickness where it is known.
+  Eigen::Vector3d voxelExtent() const {
+    Eigen::Vector3d extent = spacing;
+    if (slice_thickness_mm > 0) extent[2] = slice_thickness_mm;
+    return extent;
+  }
   long long voxelCount() const { return static_cast<long long>(size[0]) * size[1] * size[2]; }
   /// Linear index with i fastest (ITK and VTK buffer order).
   long long linear(int i, int j, int k) const {

@@ -39,6 +39,7 @@ struct ReadReport {
   double slice_spacing_mm = 0;     // measured from Image Position Patient
   double slice_spacing_spread_mm = 0;
   double gantry_tilt_deg = 0;
+  double slice_thickness_mm = 0;   // Slice Thickness (0018,0050) as the slices state it (0: not stated)
   std::vector<std::string> warnings;
 };
 

@@ -82,6 +82,10 @@ struct EdgeSnapOptions {
   /// slices and across them (0: both estimated from the CT's own edges;
   /// the slice width 0: as within the slices).
   double point_spread_mm = 0, slice_point_spread_mm = 0;
+  /// What a voxel averages over across the slices, mm, where the CT does not
+  /// say (a NIfTI file holds no slice thickness); 0: the CT's own
+  /// (imaging::ImageGeometry::voxelExtent).
+  double slice_thickness_mm = 0;
   int threads = 1;  // worker threads of the cortex model's fits (0: every hardware thread)
   /// Throws UsageError naming the first invalid option.
   void validate() const;
