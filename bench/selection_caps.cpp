@@ -11,7 +11,8 @@
 // Prints one JSON line per cap (true model, length, noise, the truth's
 // departure from the nearest simpler model on its exact cap, each model's
 // RMS, the true model's fitted from the truth, the models the points leave
-// undetermined, the two selections, and the errors of each fit containing
+// undetermined, the two selections, every test of the first with its
+// p-value (to score another rule from the same caps), and the errors of each fit containing
 // the truth in its standard errors, the true model's own fit's parameters
 // with the truth's and their standard errors); then per rule and true model the share
 // right, richer than the truth (the test's false positives) and simpler or
@@ -115,6 +116,8 @@ int main(int argc, char** argv) {
       const articula::statistics::ModelSelection chosen = articula::statistics::selectNested(articula::statistics::modelEvidence(s, n_eff));
       line["at_length"] = chosen.selected;
       line["undetermined"] = chosen.undetermined;
+      for (const articula::statistics::NestedStep& st : chosen.path)  // every test's p-value, for other rules
+        line["path"].push_back({{"simpler", st.simpler}, {"richer", st.richer}, {"p", st.p_value}});
       line["per_fit"] = articula::statistics::selectNested(articula::statistics::modelEvidence(s, NAN)).selected;
     } catch (const std::exception& e) {
       line["error"] = e.what();
