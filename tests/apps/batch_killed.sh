@@ -16,7 +16,7 @@ models=(sphere ellipsoid superellipsoid)
 # direction to them, which a sphere's points show as an ellipsoid's shape.
 echo "subject,input,joint,side,edge_model" > "$tmp/study.csv"
 for i in 1 2 3; do
-  "$bin/articula" phantom -o "$tmp/data/s$i" --seed $((20 + i)) --model "${models[$((i - 1))]}" --spacing 1,1,1 \
+  "$bin/articula" phantom -o "$tmp/data/s$i" --seed $((20 + i)) --model "${models[$((i - 1))]}" --spacing 1.2,1.2,1.2 \
     --no-dicom --quiet
   echo "s$i,data/s$i/phantom.nii.gz,hip,right,steepest" >> "$tmp/study.csv"
 done
