@@ -60,6 +60,21 @@ struct FlatCortex {
   Eigen::Vector3d spacings() const {
     return Eigen::Vector3d(spacing, spacing, slice_spacing > 0 ? slice_spacing : spacing);
   }
+  /// Faces `normal`, the lines crossing it at places spread over the plane.
+  void face(const Eigen::Vector3d& normal) {
+    n = normal.normalized();
+    across1 = n.unitOrthogonal();
+    across2 = n.cross(across1);
+  }
+  /// The cortex and levels it is made of.
+  imaging::CortexTissue tissue() const {
+    imaging::CortexTissue t;
+    t.thickness_mm = thickness;
+    t.outside_hu = soft;
+    t.cortex_hu = cortical;
+    t.inside_hu = cancellous;
+    return t;
+  }
   Eigen::Vector3d extents() const {
     return Eigen::Vector3d(spacing, spacing, slice_thickness > 0 ? slice_thickness : spacings().z());
   }
@@ -352,20 +367,14 @@ TEST(CortexEdge, ThinCortexAcrossLongSlicesHeldToItsTissue) {
   FlatCortex across;
   across.spacing = 0.8;
   across.slice_spacing = 3.0;
-  across.n = Eigen::Vector3d(0.3, 0.1, 1).normalized();  // a slice share of 0.91
-  across.across1 = across.n.unitOrthogonal();
-  across.across2 = across.n.cross(across.across1);
+  across.face(Eigen::Vector3d(0.3, 0.1, 1));  // a slice share of 0.91
   across.size = Eigen::Vector3i(44, 44, 12);
   std::vector<double> starts;
   const std::vector<imaging::LineVoxels> lines = linesAcross(across, 21, starts);
   ASSERT_GT(lines.size(), 100U);
   imaging::PointSpread spread;
   spread.sigma_mm = spread.slice_sigma_mm = across.sigma;
-  imaging::CortexTissue tissue;
-  tissue.thickness_mm = across.thickness;
-  tissue.outside_hu = across.soft;
-  tissue.cortex_hu = across.cortical;
-  tissue.inside_hu = across.cancellous;
+  const imaging::CortexTissue tissue = across.tissue();
   double free_sum = 0, held_sum = 0, steepest = 0;
   int free_found = 0, held_found = 0;
   std::vector<double> thickness;
@@ -439,20 +448,14 @@ TEST(CortexEdge, SlicesThickerThanTheirSpacingAveragedOverTheirThickness) {
     across.slice_thickness = 2.0;
     across.thickness_stated = stated;
     across.blur_on_grid = true;
-    across.n = Eigen::Vector3d(0.3, 0.1, 1).normalized();  // a slice share of 0.91
-    across.across1 = across.n.unitOrthogonal();
-    across.across2 = across.n.cross(across.across1);
+    across.face(Eigen::Vector3d(0.3, 0.1, 1));  // a slice share of 0.91
     across.size = Eigen::Vector3i(44, 44, 24);
     std::vector<double> starts;
     const std::vector<imaging::LineVoxels> lines = linesAcross(across, 43, starts);
     imaging::PointSpread spread;
     spread.sigma_mm = spread.slice_sigma_mm = across.sigma;
     spread.kind = imaging::PointSpread::Kind::VoxelGrid;
-    imaging::CortexTissue tissue;
-    tissue.thickness_mm = across.thickness;
-    tissue.outside_hu = across.soft;
-    tissue.cortex_hu = across.cortical;
-    tissue.inside_hu = across.cancellous;
+    const imaging::CortexTissue tissue = across.tissue();
     double sum = 0;
     int found = 0;
     for (size_t i = 0; i < lines.size(); ++i) {
