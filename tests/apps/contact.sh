@@ -3,6 +3,7 @@
 # answers), per-row statuses for bad rows, exit code 3 when no row is valid,
 # and a thesis table 5.3 motion with warm starts.
 set -euo pipefail
+python3() { /usr/bin/python3 "$@"; }  # Debian's, as common.bash binds it
 bin="$ARTICULA_BIN/articula"
 mkdir -p "$ARTICULA_TMP"
 out="$ARTICULA_TMP/contacts.csv"

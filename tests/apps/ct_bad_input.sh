@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Every bad input of the CT chain exits with the documented code and a clear message.
 set -uo pipefail
+python3() { /usr/bin/python3 "$@"; }  # Debian's, as common.bash binds it
 B=$ARTICULA_BIN
 T=$ARTICULA_TMP
 rm -rf "$T" && mkdir -p "$T"

@@ -4,6 +4,7 @@
 # fixtures: sphere
 # labels: full-size
 set -euo pipefail
+python3() { /usr/bin/python3 "$@"; }  # Debian's, as common.bash binds it
 B=$ARTICULA_BIN
 T=$ARTICULA_TMP
 rm -rf "$T" && mkdir -p "$T"
