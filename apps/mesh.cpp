@@ -79,8 +79,7 @@ class MeshCommand : public cli::Command {
                {"point_spread_estimated", snapped.point_spread_estimated},
                {"point_spread_applied", snapped.point_spread_on_voxel_grid ? "voxel_grid" : "scanner"},
                {"cortex_held_across_slices", snapped.cortex_held_across_slices},
-               {"slice_thickness_mm", snap.slice_thickness_mm > 0 ? snap.slice_thickness_mm
-                                                                  : ct->geometry.voxelExtent()[2]},
+               {"slice_thickness_mm", snapped.slice_thickness_mm},
                {"ct_noise_hu", snapped.ct_noise_hu},
                {"line_radius_mm", snapped.line_radius_mm},
                {"vertices_on_cortex_model", snapped.on_cortex_model},

@@ -11,12 +11,10 @@ set -euo pipefail
 D=${ARTICULA_SHARED_DATA:-}
 [[ -d "$D/ct/breast-rt-shoulders-j2k-dicom" ]] || { echo "no shared CT data: skipped"; exit 77; }
 source "$(dirname "$0")/common.bash"
-B=$bin
-T=$tmp
 for side in right left; do
-  "$B/articula" run -i "$D/ct/breast-rt-shoulders-j2k-dicom" -o "$T/breast-$side" --joint shoulder --side "$side" -q \
-    2> "$T/breast-$side.err" || fail "breast $side: exit $? ($(tail -1 "$T/breast-$side.err"))"
-  python3 - "$T/breast-$side/results.json" "$side" <<'PY'
+  "$bin/articula" run -i "$D/ct/breast-rt-shoulders-j2k-dicom" -o "$tmp/breast-$side" --joint shoulder --side "$side" -q \
+    2> "$tmp/breast-$side.err" || fail "breast $side: exit $? ($(tail -1 "$tmp/breast-$side.err"))"
+  python3 - "$tmp/breast-$side/results.json" "$side" <<'PY'
 import json, sys
 results, side = json.load(open(sys.argv[1])), sys.argv[2]
 qc = results["qc"]

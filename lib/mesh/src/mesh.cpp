@@ -484,8 +484,8 @@ void tissueOverMesh(const std::vector<std::vector<int>>& neighbours, double edge
 /// blur was taken wrongly at 0.6 mm voxels). A vertex whose model does not
 /// fit keeps its steepest fall.
 void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<int>>& neighbours,
-                        const imaging::Volume& ct, const std::vector<char>& found, std::vector<double>& shift,
-                        const EdgeSnapOptions& options, EdgeSnapSummary& s) {
+                        const imaging::Volume& ct, const Eigen::Vector3d& extent, const std::vector<char>& found,
+                        std::vector<double>& shift, const EdgeSnapOptions& options, EdgeSnapSummary& s) {
   constexpr size_t kPointSpreadLines = 600;
   constexpr double kTypicalCortexRatio = 1.5;  // a line within the slices tells the cortex when within this factor of the median
   // The lines run along the normals of the surface moved onto the steepest
@@ -503,7 +503,6 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   }
   on_falls.normals = fromVtk(withNormals(toVtk(on_falls))).normals;
   const double edge_mm = meanEdgeLength(on_falls, neighbours);
-  const Eigen::Vector3d extent = voxelExtent(ct, options);
   const double slices_mm = imaging::tissueHeldAcrossSlices(extent) ? extent[2] : 0.0;
   on_falls.normals = smoothedNormals(on_falls, neighbours, edge_mm, std::max(1.0, slices_mm));
   const std::vector<double> curvature = meanCurvature(on_falls, neighbours, edge_mm, std::max(2.0, 2 * slices_mm));
@@ -666,6 +665,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
        std::max(ct.geometry.spacing[0], ct.geometry.spacing[1]) <= kCortexModelMaxInPlaneMm + 1e-6 &&
        ct.geometry.spacing[2] <= kCortexModelMaxSliceMm + 1e-6);
   const Eigen::Vector3d extent = voxelExtent(ct, options);
+  s.slice_thickness_mm = extent[2];
   const bool long_slices = imaging::tissueHeldAcrossSlices(extent);
   if (cortex_model) {
     s.ct_noise_hu = imaging::noiseHu(ct);
@@ -714,7 +714,7 @@ void snapToEdges(TriangleMesh& mesh, const imaging::Volume& ct, const EdgeSnapOp
     cut.assign(static_cast<size_t>(n), 0);
     for (Eigen::Index v = 0; v < n; ++v) cut[static_cast<size_t>(v)] = !found[static_cast<size_t>(v)];
   }
-  if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, found, shift, options, s);
+  if (cortex_model) placeOnCortexModel(mesh, neighbours, ct, extent, found, shift, options, s);
   averageShifts(neighbours, std::max(options.smoothing_passes, 1), shift, found);
   for (Eigen::Index v = 0; v < n; ++v) {
     const double d = found[static_cast<size_t>(v)] ? shift[static_cast<size_t>(v)] : 0.0;

@@ -106,6 +106,7 @@ struct EdgeSnapSummary {
   bool cortex_held_across_slices = false;   // the lines across the slices held the cortex of the lines within them
   double ct_noise_hu = 0;                   // the CT's noise voxel to voxel (imaging::noiseHu), which widens the model's lines
   double line_radius_mm = 0;                // the model's lines' radius within the slices (imaging::lineRadiusFor)
+  double slice_thickness_mm = 0;            // what a voxel was taken to average over across the slices
   long long on_cortex_model = 0;
   double mean_model_shift_mm = 0;
   std::string cortex_model_note;  // why the model was not used, when it was asked for
