@@ -84,23 +84,40 @@ std::vector<double> spreadOver(const std::vector<double>& density, double& first
 
 /// `density` (every kTableStepMm from `first_mm`) averaged over a box of
 /// `width_mm` about each point: differences of its running sum, read
-/// between steps by linear interpolation.
+/// between steps by linear interpolation. Every output reads the running
+/// sum at the same fraction of a step, so each end of the box is a fixed
+/// index offset and one weight (this ran for every line at every width
+/// tried, and per-point floors and clamps took most of the mesh stage's
+/// point-spread estimate).
 std::vector<double> boxOver(const std::vector<double>& density, double& first_mm, double width_mm) {
   const double half = 0.5 * width_mm / kTableStepMm;  // in steps
-  const auto pad = static_cast<size_t>(std::ceil(half)) + 1;
-  std::vector<double> running(density.size() + 1, 0.0);  // running[i]: the sum of the first i steps
-  for (size_t i = 0; i < density.size(); ++i) running[i + 1] = running[i] + density[i];
-  // The sum of the steps whose middles lie below position x (in steps from the first middle).
-  const auto below = [&](double x) {
-    const double at = std::clamp(x + 0.5, 0.0, static_cast<double>(density.size()));
-    const auto i = static_cast<size_t>(std::floor(at));
-    return i >= density.size() ? running.back() : running[i] + (at - static_cast<double>(i)) * density[i];
-  };
-  std::vector<double> out(density.size() + 2 * pad, 0.0);
-  for (size_t i = 0; i < out.size(); ++i) {
-    const double x = static_cast<double>(i) - static_cast<double>(pad);
-    out[i] = (below(x + half) - below(x - half)) / (2 * half);
+  const auto pad = static_cast<std::ptrdiff_t>(std::ceil(half)) + 1;
+  const auto n = static_cast<std::ptrdiff_t>(density.size());
+  const std::ptrdiff_t size = n + 2 * pad;
+  // The running sum and the density on a margin of `size` steps either
+  // side: the sum 0 below the first step and the total beyond the last,
+  // the density 0 outside, so no read needs a clamp.
+  const std::ptrdiff_t margin = size;
+  std::vector<double> running(static_cast<size_t>(n + 2 * margin + 1), 0.0), steps(running.size(), 0.0);
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    steps[static_cast<size_t>(margin + i)] = density[static_cast<size_t>(i)];
+    running[static_cast<size_t>(margin + i + 1)] = running[static_cast<size_t>(margin + i)] + density[static_cast<size_t>(i)];
   }
+  for (auto i = static_cast<size_t>(margin + n + 1); i < running.size(); ++i) running[i] = running[i - 1];
+  // The sum of the steps whose middles lie below output i's end at `end`
+  // steps from it (its position: i - pad + end + 0.5 from the first middle).
+  const auto end = [&](double reach) {
+    const double at = reach + 0.5 - static_cast<double>(pad), whole = std::floor(at);
+    return std::pair<std::ptrdiff_t, double>{margin + static_cast<std::ptrdiff_t>(whole), at - whole};
+  };
+  const auto [upper, upper_share] = end(half);
+  const auto [lower, lower_share] = end(-half);
+  const double scale = 1.0 / (2 * half);
+  std::vector<double> out(static_cast<size_t>(size));
+  const double *ru = running.data() + upper, *du = steps.data() + upper;
+  const double *rl = running.data() + lower, *dl = steps.data() + lower;
+  for (std::ptrdiff_t i = 0; i < size; ++i)
+    out[static_cast<size_t>(i)] = ((ru[i] + upper_share * du[i]) - (rl[i] + lower_share * dl[i])) * scale;
   first_mm -= static_cast<double>(pad) * kTableStepMm;
   return out;
 }
