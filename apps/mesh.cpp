@@ -56,7 +56,7 @@ class MeshCommand : public cli::Command {
     // value but 0 is bone.
     const std::optional<nlohmann::json> sidecar = readJsonFileIfValid(input_.string() + ".json");
     const bool marks_its_cut = sidecar && sidecar->is_object() && sidecar->contains("cut_through_bone_voxels");
-    const imaging::Label label = imaging::readLabel(input_, marks_its_cut);
+    const imaging::Label label = imaging::readLabel(input_, marks_its_cut, common.memory);
     mesh::MeshSummary s;
     mesh::TriangleMesh m = mesh::extractSurface(label, options, &s);
     nlohmann::json edges = nullptr;

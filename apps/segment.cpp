@@ -69,6 +69,7 @@ class SegmentCommand : public cli::Command {
     const imaging::Label label = imaging::segmentHead(ct, options, &s);
     for (const auto& w : s.warnings) log::warn(w);
     imaging::writeLabel(output_, label, true);
+    imaging::keepWrittenLabel(output_, label, common.memory);
 
     nlohmann::json params = {{"joint", joint_}, {"side", side_}, {"hu_min", options.hu_min},
                              {"hu_max", options.hu_max}, {"surface_hu", options.surface_hu}, {"series_uid", given.series_uid},

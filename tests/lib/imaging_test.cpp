@@ -92,6 +92,46 @@ TEST(ImagingIo, RunMemoryAnswersARepeatedReadUntilTheFileChanges) {
   std::filesystem::remove_all(dir);
 }
 
+// A label a run's stage wrote and kept is read back from memory as the file
+// would give it: the same voxels (values normalised as from the file, the
+// cut kept only when asked) and the same grid, bit for bit; once the file
+// changes, it is read from the file.
+TEST(ImagingIo, KeptLabelReadsAsItsFileUntilTheFileChanges) {
+  const phantom::Phantom p = smallPhantom(6);
+  imaging::Label label = p.femur;
+  size_t marked = 0;
+  for (size_t n = 0; n < label.voxels.size() && marked < 40; ++n)
+    if (label.voxels[n] != 0) label.voxels[n] = marked++ % 2 ? imaging::kLabelCutThroughBone : 7;
+  ASSERT_EQ(marked, 40u);
+  const auto dir = testing::scratch("kept-label");
+  const auto file = dir / "label.nii.gz";
+  imaging::writeLabel(file, label);
+  RunMemory memory;
+  imaging::keepWrittenLabel(file, label, &memory);
+  for (const bool keep_cut : {false, true}) {
+    const long long hits = memory.hits();
+    const imaging::Label kept = imaging::readLabel(file, keep_cut, &memory);
+    EXPECT_EQ(memory.hits(), hits + 1);
+    const imaging::Label from_file = imaging::readLabel(file, keep_cut);
+    EXPECT_EQ(kept.voxels, from_file.voxels);
+    EXPECT_EQ(kept.geometry.size, from_file.geometry.size);
+    EXPECT_EQ(kept.geometry.spacing, from_file.geometry.spacing);
+    EXPECT_EQ(kept.geometry.origin, from_file.geometry.origin);
+    EXPECT_EQ(kept.geometry.direction, from_file.geometry.direction);
+    EXPECT_EQ(std::count(kept.voxels.begin(), kept.voxels.end(), imaging::kLabelCutThroughBone), keep_cut ? 20 : 0);
+    EXPECT_EQ(std::count(kept.voxels.begin(), kept.voxels.end(), 7), 0);
+  }
+  imaging::Label changed = label;
+  std::fill(changed.voxels.begin(), changed.voxels.end(), 0);
+  imaging::writeLabel(file, changed);
+  std::filesystem::last_write_time(file, std::filesystem::last_write_time(file) + std::chrono::seconds(2));
+  const long long hits = memory.hits();
+  const imaging::Label reread = imaging::readLabel(file, false, &memory);
+  EXPECT_EQ(memory.hits(), hits);
+  EXPECT_EQ(std::count(reread.voxels.begin(), reread.voxels.end(), 0), static_cast<long>(reread.voxels.size()));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ImagingIo, DicomSeriesRoundTripAndChecks) {
   const phantom::Phantom p = smallPhantom(3, true);
   const auto dir = testing::scratch("dicom");

@@ -660,16 +660,44 @@ ImageGeometry readImageGeometry(const fs::path& input) {
   return g;
 }
 
-Label readLabel(const fs::path& input, bool keep_cut) {
+namespace {
+
+/// A label's voxels as its file stores them (uint8), kept in a run's memory.
+struct KeptLabel {
+  std::vector<std::uint8_t> voxels;
+};
+
+/// What identifies a label file in a run: its path, size and modification time.
+std::string labelKey(const fs::path& path) { return readKey(path, ReadOptions{}); }
+
+/// 0 stays 0; kLabelCutThroughBone stays with `keep_cut`; every other value is kLabelBone.
+void normaliseLabel(std::vector<std::uint8_t>& voxels, bool keep_cut) {
+  for (auto& v : voxels) v = v == 0 ? 0 : keep_cut && v == kLabelCutThroughBone ? kLabelCutThroughBone : kLabelBone;
+}
+
+}  // namespace
+
+Label readLabel(const fs::path& input, bool keep_cut, RunMemory* memory) {
   if (!fs::is_regular_file(input)) throw InputError("label image not found: " + input.string());
   if (!isImageFile(input)) throw InputError("expected a label image (.nii.gz/.nrrd/.mha), found " + input.string());
   // A uint8 label (as articula writes them) is read as it is stored: a float
   // copy of a CT-sized label is four times the memory and time.
   if (storedComponentType(input) == itk::IOComponentEnum::UCHAR) {
+    if (memory) {
+      const auto kept = memory->kept<KeptLabel>("label", labelKey(input), [&] {
+        return KeptLabel{readImageFile<std::uint8_t>(input).voxels};
+      });
+      Label label;
+      label.geometry = readImageGeometry(input);
+      if (static_cast<size_t>(label.geometry.voxelCount()) == kept->voxels.size()) {
+        label.voxels = kept->voxels;
+        normaliseLabel(label.voxels, keep_cut);
+        return label;
+      }
+    }
     Label label = readImageFile<std::uint8_t>(input);
     checkDirection(label.geometry.direction, input.string());
-    for (auto& v : label.voxels)
-      v = v == 0 ? 0 : keep_cut && v == kLabelCutThroughBone ? kLabelCutThroughBone : kLabelBone;
+    normaliseLabel(label.voxels, keep_cut);
     return label;
   }
   const Image<float> raw = readImageFile<float>(input);
@@ -679,6 +707,11 @@ Label readLabel(const fs::path& input, bool keep_cut) {
   label.voxels.resize(raw.voxels.size());
   for (size_t n = 0; n < raw.voxels.size(); ++n) label.voxels[n] = raw.voxels[n] > 0.5f ? kLabelBone : 0;
   return label;
+}
+
+void keepWrittenLabel(const fs::path& path, const Label& label, RunMemory* memory) {
+  if (!memory) return;
+  memory->kept<KeptLabel>("label", labelKey(path), [&] { return KeptLabel{label.voxels}; });
 }
 
 void writeVolume(const fs::path& path, const Volume& volume, bool overwrite) {

@@ -186,7 +186,7 @@ std::string slicesThroughHead(const SubjectReportOptions& o, const imaging::Volu
     for (const auto& shape : shapes)
       if (geometry::modelName(shape.model) == selected) model = shape;
     std::optional<imaging::Label> label;
-    if (fs::exists(o.folder / "label.nii.gz")) label = imaging::readLabel(o.folder / "label.nii.gz");
+    if (fs::exists(o.folder / "label.nii.gz")) label = imaging::readLabel(o.folder / "label.nii.gz", false, o.memory);
     return headSlicesHtml(*ct, label ? &*label : nullptr, model, 1.6 * model.radii.maxCoeff(),
                           std::min(0.5, ct->geometry.spacing.minCoeff()));
   } catch (const Error& e) {

@@ -71,8 +71,15 @@ ImageGeometry readImageGeometry(const std::filesystem::path& input);
 
 /// Reads a label image (any integer type, non-zero = kLabelBone). With
 /// `keep_cut` (a label articula's segmentation wrote), its voxels of
-/// kLabelCutThroughBone keep that value.
-Label readLabel(const std::filesystem::path& input, bool keep_cut = false);
+/// kLabelCutThroughBone keep that value. With a run's `memory`, a file
+/// unchanged since keepWrittenLabel kept it (or since an earlier read in the
+/// run) is taken from memory: the same voxels, the grid from its header.
+Label readLabel(const std::filesystem::path& input, bool keep_cut = false, RunMemory* memory = nullptr);
+
+/// In a run (`memory` given, else nothing): keeps `label`, just written to
+/// `path` by writeLabel, for the run's later readLabel of that file (a
+/// CT-sized label took a sixth of a second to inflate for each stage).
+void keepWrittenLabel(const std::filesystem::path& path, const Label& label, RunMemory* memory);
 
 /// Writes a volume (as int16 HU) or a label (uint8) to .nii.gz/.nii/.nrrd/.mha,
 /// atomically (temporary name, then rename).
