@@ -434,6 +434,55 @@ TEST(CortexEdge, WidthWithinLongSlicesFromTheLinesWithinThem) {
   EXPECT_GT(found, 250);
 }
 
+// The same planes with a sample that has too few lines within the slices
+// for their width (a hip's socket takes many out): further lines from the
+// band within the slices tell it, and lines given as such that cross the
+// slices are not taken.
+TEST(CortexEdge, MoreLinesWithinLongSlicesTellTheWidthWithinThem) {
+  std::vector<FlatCortex> planes(3);
+  planes[0].n = Eigen::Vector3d(1, 0.21, 0.02).normalized();
+  planes[1].n = Eigen::Vector3d(0.8, -0.2, 0.3).normalized();
+  planes[2].n = Eigen::Vector3d(0.6, 0.3, 0.6).normalized();
+  std::vector<imaging::LineVoxels> lines, more, across;
+  std::vector<double> more_starts;
+  unsigned seed = 31;
+  for (FlatCortex& plane : planes) {
+    plane.spacing = 0.6;
+    plane.sigma = 0.6;
+    plane.slice_spacing = 3.0;
+    plane.slice_samples = 2;
+    plane.blur_on_grid = true;
+    plane.size = Eigen::Vector3i(44, 44, 12);
+    plane.across1 = plane.n.unitOrthogonal();
+    plane.across2 = plane.n.cross(plane.across1);
+    std::vector<double> starts;
+    const auto own = linesAcross(plane, seed++, starts);
+    if (more.empty()) {
+      more = own, more_starts = starts;
+    } else {
+      across.insert(across.end(), own.begin(), own.end());
+    }
+  }
+  ASSERT_GT(more.size(), 200u);
+  lines = across;
+  lines.insert(lines.end(), more.begin(), more.begin() + 20);  // fewer than the 30 a width needs
+  more.erase(more.begin(), more.begin() + 20);
+  more_starts.erase(more_starts.begin(), more_starts.begin() + 20);
+
+  const imaging::PointSpread alone = imaging::estimatePointSpread(lines);
+  const imaging::PointSpread told = imaging::estimatePointSpread(lines, 1, more);
+  ASSERT_TRUE(alone.found);
+  ASSERT_TRUE(told.found);
+  EXPECT_GT(std::abs(alone.sigma_mm - told.sigma_mm), 0.005) << "every line's width, kept alone";
+  EXPECT_NEAR(told.sigma_mm, planes[0].sigma, 0.03);
+  int found = 0;
+  EXPECT_NEAR(meanModelSurface(more, more_starts, told, found), 0.0, 0.05);
+  EXPECT_GT(found, 200);
+  const imaging::PointSpread crossing = imaging::estimatePointSpread(lines, 1, across);
+  EXPECT_EQ(crossing.sigma_mm, alone.sigma_mm);
+  EXPECT_EQ(crossing.slice_sigma_mm, alone.slice_sigma_mm);
+}
+
 // Slices reconstructed twice as thick as their spacing (2 mm every 1 mm),
 // blurred on the grid as the phantom's are: each voxel averages the bone
 // over its thickness. Where the CT states it (a DICOM series' Slice

@@ -487,6 +487,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
                         const imaging::Volume& ct, const Eigen::Vector3d& extent, const std::vector<char>& found,
                         std::vector<double>& shift, const EdgeSnapOptions& options, EdgeSnapSummary& s) {
   constexpr size_t kPointSpreadLines = 600;
+  constexpr size_t kMoreLinesWithinSlices = 300;  // across long slices, for the width within them
   constexpr double kTypicalCortexRatio = 1.5;  // a line within the slices tells the cortex when within this factor of the median
   constexpr double kTissueTellingShare = 0.01;  // of a line's direction across the slices (within about 6 degrees of their plane) ...
   constexpr size_t kMinTissueTellingLines = 30;  // ... where at least this many such lines fit (else the whole band within the slices)
@@ -532,7 +533,23 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     std::vector<imaging::LineVoxels> lines;
     const size_t stride = std::max<size_t>(1, on_edge.size() / kPointSpreadLines);
     for (size_t i = 0; i < on_edge.size(); i += stride) lines.push_back(lineAt(on_edge[i], false));
-    spread = imaging::estimatePointSpread(lines, options.threads);
+    // Across long slices the width within them comes from the lines within
+    // them alone, a fifth of the sample, less where the socket takes lines
+    // out: 46 lines of 2 mm slices gave a likelihood flat from 0.56 to 0.70
+    // mm and a surface 0.22 mm inside. More are taken from the band within
+    // the slices, for that width only.
+    std::vector<imaging::LineVoxels> band_lines;
+    if (imaging::tissueHeldAcrossSlices(extent)) {
+      const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
+      std::vector<size_t> band;
+      for (size_t i = 0; i < on_edge.size(); ++i) {
+        const double across = on_falls.normals.row(on_edge[i]).dot(slice_axis.transpose());
+        if (i % stride != 0 && across * across < imaging::kWithinSlicesShare) band.push_back(i);
+      }
+      const size_t band_stride = std::max<size_t>(1, band.size() / kMoreLinesWithinSlices);
+      for (size_t j = 0; j < band.size(); j += band_stride) band_lines.push_back(lineAt(on_edge[band[j]], false));
+    }
+    spread = imaging::estimatePointSpread(lines, options.threads, band_lines);
     if (!spread.found) {
       s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(spread.profiles) +
                             " edges; the edges are the steepest falls";

@@ -196,8 +196,11 @@ struct PointSpread {
 /// again on the lines across them, each fitted with the tissue of its
 /// nearest lines within the slices (nearbyTissue): across long or thick
 /// slices a thin cortex's thickness trades against the blur, and the width
-/// with it (held_across).
-PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, int threads = 1);
+/// with it (held_across). `more_within_slices`: further lines within long
+/// slices that join those of `lines` there for the width within them and
+/// the tissue held across them, and take part in nothing else.
+PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, int threads = 1,
+                                const std::vector<LineVoxels>& more_within_slices = {});
 
 /// Lines whose slice share is below this lie within the slices: across
 /// them a line sees the in-plane voxel's extent and blur only.
