@@ -399,38 +399,45 @@ TEST(CortexEdge, ThinCortexAcrossLongSlicesHeldToItsTissue) {
 // Synthetic CTs take a voxel's partial volume from a few samples across
 // its slice (two here, 1.5 mm apart in a 3 mm slice) and blur on the grid,
 // hardly at all across slices this long: the lines across the slices see a
-// profile unlike the model's box. Fitted with every line, the width within
-// the slices came out short and the surface facing within them outside;
-// the lines within the slices tell it.
-TEST(CortexEdge, WidthWithinLongSlicesFromTheLinesWithinThem) {
-  std::vector<FlatCortex> planes(3);
-  planes[0].n = Eigen::Vector3d(1, 0.21, 0.02).normalized();
-  planes[1].n = Eigen::Vector3d(0.8, -0.2, 0.3).normalized();
-  planes[2].n = Eigen::Vector3d(0.6, 0.3, 0.6).normalized();
-  std::vector<imaging::LineVoxels> lines, within;
-  std::vector<double> starts, within_starts;
+// profile unlike the model's box. Three planes, the first facing within the
+// slices, the others across them; each plane's lines and their starts.
+constexpr double kLongSlicesSigma = 0.6;
+std::vector<std::vector<imaging::LineVoxels>> linesOfPlanesInLongSlices(std::vector<std::vector<double>>& starts) {
+  const Eigen::Vector3d normals[] = {Eigen::Vector3d(1, 0.21, 0.02), Eigen::Vector3d(0.8, -0.2, 0.3),
+                                     Eigen::Vector3d(0.6, 0.3, 0.6)};
+  std::vector<std::vector<imaging::LineVoxels>> lines;
+  starts.clear();
   unsigned seed = 31;
-  for (FlatCortex& plane : planes) {
+  for (const Eigen::Vector3d& n : normals) {
+    FlatCortex plane;
+    plane.n = n.normalized();
     plane.spacing = 0.6;
-    plane.sigma = 0.6;
+    plane.sigma = kLongSlicesSigma;
     plane.slice_spacing = 3.0;
     plane.slice_samples = 2;
     plane.blur_on_grid = true;
     plane.size = Eigen::Vector3i(44, 44, 12);
     plane.across1 = plane.n.unitOrthogonal();
     plane.across2 = plane.n.cross(plane.across1);
-    std::vector<double> own_starts;
-    const auto more = linesAcross(plane, seed++, own_starts);
-    if (within.empty()) within = more, within_starts = own_starts;
-    lines.insert(lines.end(), more.begin(), more.end());
-    starts.insert(starts.end(), own_starts.begin(), own_starts.end());
+    starts.emplace_back();
+    lines.push_back(linesAcross(plane, seed++, starts.back()));
   }
+  return lines;
+}
+
+// Fitted with every line, the width within the slices came out short and
+// the surface facing within them outside; the lines within the slices tell it.
+TEST(CortexEdge, WidthWithinLongSlicesFromTheLinesWithinThem) {
+  std::vector<std::vector<double>> starts;
+  const auto planes = linesOfPlanesInLongSlices(starts);
+  std::vector<imaging::LineVoxels> lines;
+  for (const auto& own : planes) lines.insert(lines.end(), own.begin(), own.end());
   const imaging::PointSpread spread = imaging::estimatePointSpread(lines);
   ASSERT_TRUE(spread.found);
   EXPECT_TRUE(spread.held_across);
-  EXPECT_NEAR(spread.sigma_mm, planes[0].sigma, 0.03);
+  EXPECT_NEAR(spread.sigma_mm, kLongSlicesSigma, 0.03);
   int found = 0;
-  EXPECT_NEAR(meanModelSurface(within, within_starts, spread, found), 0.0, 0.05);
+  EXPECT_NEAR(meanModelSurface(planes[0], starts[0], spread, found), 0.0, 0.05);
   EXPECT_GT(found, 250);
 }
 
@@ -439,42 +446,23 @@ TEST(CortexEdge, WidthWithinLongSlicesFromTheLinesWithinThem) {
 // band within the slices tell it, and lines given as such that cross the
 // slices are not taken.
 TEST(CortexEdge, MoreLinesWithinLongSlicesTellTheWidthWithinThem) {
-  std::vector<FlatCortex> planes(3);
-  planes[0].n = Eigen::Vector3d(1, 0.21, 0.02).normalized();
-  planes[1].n = Eigen::Vector3d(0.8, -0.2, 0.3).normalized();
-  planes[2].n = Eigen::Vector3d(0.6, 0.3, 0.6).normalized();
-  std::vector<imaging::LineVoxels> lines, more, across;
-  std::vector<double> more_starts;
-  unsigned seed = 31;
-  for (FlatCortex& plane : planes) {
-    plane.spacing = 0.6;
-    plane.sigma = 0.6;
-    plane.slice_spacing = 3.0;
-    plane.slice_samples = 2;
-    plane.blur_on_grid = true;
-    plane.size = Eigen::Vector3i(44, 44, 12);
-    plane.across1 = plane.n.unitOrthogonal();
-    plane.across2 = plane.n.cross(plane.across1);
-    std::vector<double> starts;
-    const auto own = linesAcross(plane, seed++, starts);
-    if (more.empty()) {
-      more = own, more_starts = starts;
-    } else {
-      across.insert(across.end(), own.begin(), own.end());
-    }
-  }
-  ASSERT_GT(more.size(), 200u);
-  lines = across;
-  lines.insert(lines.end(), more.begin(), more.begin() + 20);  // fewer than the 30 a width needs
-  more.erase(more.begin(), more.begin() + 20);
-  more_starts.erase(more_starts.begin(), more_starts.begin() + 20);
+  std::vector<std::vector<double>> starts;
+  const auto planes = linesOfPlanesInLongSlices(starts);
+  ASSERT_GT(planes[0].size(), 220u);
+  std::vector<imaging::LineVoxels> lines = planes[1], across = planes[1];
+  lines.insert(lines.end(), planes[2].begin(), planes[2].end());
+  across.insert(across.end(), planes[2].begin(), planes[2].end());
+  constexpr size_t kFewWithin = 20;  // fewer than the 30 a width needs
+  lines.insert(lines.end(), planes[0].begin(), planes[0].begin() + kFewWithin);
+  const std::vector<imaging::LineVoxels> more(planes[0].begin() + kFewWithin, planes[0].end());
+  const std::vector<double> more_starts(starts[0].begin() + kFewWithin, starts[0].end());
 
   const imaging::PointSpread alone = imaging::estimatePointSpread(lines);
   const imaging::PointSpread told = imaging::estimatePointSpread(lines, 1, more);
   ASSERT_TRUE(alone.found);
   ASSERT_TRUE(told.found);
   EXPECT_GT(std::abs(alone.sigma_mm - told.sigma_mm), 0.005) << "every line's width, kept alone";
-  EXPECT_NEAR(told.sigma_mm, planes[0].sigma, 0.03);
+  EXPECT_NEAR(told.sigma_mm, kLongSlicesSigma, 0.03);
   int found = 0;
   EXPECT_NEAR(meanModelSurface(more, more_starts, told, found), 0.0, 0.05);
   EXPECT_GT(found, 200);
