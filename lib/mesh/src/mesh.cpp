@@ -526,6 +526,13 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   std::vector<Eigen::Index> on_edge;
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
     if (found[static_cast<size_t>(v)]) on_edge.push_back(v);
+  // The squared share of a vertex's normal across the slices (below
+  // imaging::kWithinSlicesShare its line lies within them).
+  const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
+  const auto shareAcrossSlices = [&](Eigen::Index v) {
+    const double across = on_falls.normals.row(v).dot(slice_axis.transpose());
+    return across * across;
+  };
   imaging::PointSpread spread;
   spread.sigma_mm = options.point_spread_mm;
   spread.slice_sigma_mm = options.slice_point_spread_mm > 0 ? options.slice_point_spread_mm : options.point_spread_mm;
@@ -540,12 +547,9 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     // the slices, for that width only.
     std::vector<imaging::LineVoxels> band_lines;
     if (imaging::tissueHeldAcrossSlices(extent)) {
-      const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
       std::vector<size_t> band;
-      for (size_t i = 0; i < on_edge.size(); ++i) {
-        const double across = on_falls.normals.row(on_edge[i]).dot(slice_axis.transpose());
-        if (i % stride != 0 && across * across < imaging::kWithinSlicesShare) band.push_back(i);
-      }
+      for (size_t i = 0; i < on_edge.size(); ++i)
+        if (i % stride != 0 && shareAcrossSlices(on_edge[i]) < imaging::kWithinSlicesShare) band.push_back(i);
       const size_t band_stride = std::max<size_t>(1, band.size() / kMoreLinesWithinSlices);
       for (size_t j = 0; j < band.size(); j += band_stride) band_lines.push_back(lineAt(on_edge[band[j]], false));
     }
@@ -560,13 +564,10 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
   const bool held_across = s.point_spread_estimated ? spread.held_across
                                                     : imaging::tissueHeldAcrossSlices(extent, spread.sigma_mm,
                                                                                       spread.slice_sigma_mm);
-  const Eigen::Vector3d slice_axis = ct.geometry.direction.col(2);
   std::vector<char> within(static_cast<size_t>(mesh.vertices.rows()), 1);
   if (held_across)
-    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
-      const double across = on_falls.normals.row(v).dot(slice_axis.transpose());
-      within[static_cast<size_t>(v)] = across * across < imaging::kWithinSlicesShare;
-    }
+    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+      within[static_cast<size_t>(v)] = shareAcrossSlices(v) < imaging::kWithinSlicesShare;
   s.cortex_held_across_slices = held_across;
   s.point_spread_mm = spread.sigma_mm;
   s.slice_point_spread_mm = spread.slice_sigma_mm;
@@ -609,18 +610,15 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
     const auto typicalFit = [&](size_t i) {
       return fits[i].found && std::abs(std::log(fits[i].thickness_mm / typical)) < std::log(kTypicalCortexRatio);
     };
-    const auto shareAcross = [&](size_t i) {
-      const double across = on_falls.normals.row(on_edge[i]).dot(slice_axis.transpose());
-      return across * across;
-    };
     size_t nearest_plane = 0;
-    for (size_t i = 0; i < on_edge.size(); ++i) nearest_plane += typicalFit(i) && shareAcross(i) < kTissueTellingShare;
+    for (size_t i = 0; i < on_edge.size(); ++i)
+      nearest_plane += typicalFit(i) && shareAcrossSlices(on_edge[i]) < kTissueTellingShare;
     const double telling_share =
         nearest_plane >= kMinTissueTellingLines ? kTissueTellingShare : imaging::kWithinSlicesShare;
     std::vector<imaging::CortexTissue> tissue(static_cast<size_t>(mesh.vertices.rows()));
     std::vector<char> known(tissue.size(), 0);
     for (size_t i = 0; i < on_edge.size(); ++i)
-      if (typicalFit(i) && shareAcross(i) < telling_share) {
+      if (typicalFit(i) && shareAcrossSlices(on_edge[i]) < telling_share) {
         tissue[static_cast<size_t>(on_edge[i])] = fits[i];
         known[static_cast<size_t>(on_edge[i])] = 1;
       }
