@@ -378,6 +378,7 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
   }
   const double across_slices = g.direction.col(2).dot(u);
   line.slice_share = across_slices * across_slices;
+  line.curvature_per_mm = curvature_per_mm;
   // A voxel averages the bone over its extent across the line too, where a
   // curved surface lies deeper the further out: its value tells the surface
   // at its centre moved by the curvature times half that extent's variance
@@ -463,6 +464,33 @@ StepResponse::StepResponse(const LineVoxels& line, const PointSpread& spread) {
     running += density[i];
   }
   for (double& share : table_) share /= running;
+}
+
+double curvatureShiftMm(const LineVoxels& line, const PointSpread& spread) {
+  double across_line_mm2 = 0;  // the blur's variance across the line, summed over both directions
+  for (int a = 0; a < 3; ++a) {
+    const double width_mm = a == 2 ? spread.slice_sigma_mm : spread.sigma_mm;
+    double variance_mm2 = width_mm * width_mm;
+    if (spread.kind == PointSpread::Kind::VoxelGrid) {
+      // The Gaussian sampled at whole voxels, as StepResponse lays it: its
+      // weights' own variance (narrower than the Gaussian's below a voxel).
+      const double width_voxels = width_mm / line.spacing_mm[a];
+      variance_mm2 = 0;
+      if (width_voxels >= 0.1) {
+        const int reach = std::max(1, static_cast<int>(std::ceil(kGridKernelWidths * width_voxels)));
+        double sum = 1, moment = 0;
+        for (int j = 1; j <= reach; ++j) {
+          const double w = std::exp(-0.5 * j * j / (width_voxels * width_voxels));
+          sum += 2 * w;
+          moment += 2 * w * j * j;
+        }
+        variance_mm2 = moment / sum * line.spacing_mm[a] * line.spacing_mm[a];
+      }
+    }
+    const double along = line.spacing_mm[a] > 0 ? line.axis_step_mm[a] / line.spacing_mm[a] : 0;
+    across_line_mm2 += variance_mm2 * (1 - along * along);
+  }
+  return 0.5 * line.curvature_per_mm * across_line_mm2;
 }
 
 double StepResponse::brightShare(double depth_mm) const {

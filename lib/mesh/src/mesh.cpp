@@ -585,6 +585,8 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
         const imaging::LineVoxels line = lineAt(on_edge[i], true);
         fits[i] = imaging::fitCortex(line, 0.0, imaging::StepResponse(line, spread), options.min_contrast_hu,
                                      held ? &(*held)[v] : nullptr);
+        // The model blurs a flat step; the head's convex surface lies that much further out.
+        fits[i].offset_mm += imaging::curvatureShiftMm(line, spread);
       }
     });
   };
