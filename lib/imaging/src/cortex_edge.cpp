@@ -418,20 +418,23 @@ LineVoxels voxelsAboutLine(const Volume& volume, const Eigen::Vector3d& x, const
 namespace {
 
 // A Gaussian of `width_voxels` sampled at whole voxels as image filters
-// take it, to kGridKernelWidths widths: its weights at 0, 1, ... voxels,
-// unnormalised (1 at 0). exp(-j^2 / 2 w^2) by its ratio from j to j + 1,
-// q^(2 j + 1), q = exp(-1 / 2 w^2).
-std::vector<double> gridWeights(double width_voxels) {
-  const int reach = std::max(1, static_cast<int>(std::ceil(kGridKernelWidths * width_voxels)));
-  std::vector<double> weights(static_cast<size_t>(reach + 1), 1.0);
+// take it, to kGridKernelWidths widths: how many voxels it reaches, and
+// `visit(j, weight)` for j = 0 .. reach, unnormalised (1 at 0), without a
+// buffer (a step response is made for every line at every width tried).
+// exp(-j^2 / 2 w^2) by its ratio from j to j + 1, q^(2 j + 1), q = exp(-1 / 2 w^2).
+int gridReach(double width_voxels) {
+  return std::max(1, static_cast<int>(std::ceil(kGridKernelWidths * width_voxels)));
+}
+template <typename Visit>
+void forEachGridWeight(double width_voxels, Visit visit) {
   const double q = std::exp(-0.5 / (width_voxels * width_voxels)), q2 = q * q;
   double w = 1, ratio = q;
-  for (int j = 1; j <= reach; ++j) {
+  visit(0, 1.0);
+  for (int j = 1, reach = gridReach(width_voxels); j <= reach; ++j) {
     w *= ratio;
     ratio *= q2;
-    weights[static_cast<size_t>(j)] = w;
+    visit(j, w);
   }
-  return weights;
 }
 
 }  // namespace
@@ -451,17 +454,14 @@ StepResponse::StepResponse(const LineVoxels& line, const PointSpread& spread) {
   for (int a = 0; a < 3; ++a) {
     const double width_voxels = (a == 2 ? spread.slice_sigma_mm : spread.sigma_mm) / line.spacing_mm[a];
     if (!(width_voxels >= 0.1) || line.axis_step_mm[a] == 0) continue;  // weights beyond the voxel itself below e^-50
-    const std::vector<double> weights = gridWeights(width_voxels);
-    const auto reach = static_cast<int>(weights.size()) - 1;
+    const int reach = gridReach(width_voxels);
     std::vector<std::pair<double, double>> taps(static_cast<size_t>(2 * reach + 1));
-    double sum = weights[0];
-    taps[static_cast<size_t>(reach)] = {0.0, weights[0]};
-    for (int j = 1; j <= reach; ++j) {
-      const double w = weights[static_cast<size_t>(j)];
+    double sum = 0;
+    forEachGridWeight(width_voxels, [&](int j, double w) {
       taps[static_cast<size_t>(reach + j)] = {j * line.axis_step_mm[a], w};
       taps[static_cast<size_t>(reach - j)] = {-j * line.axis_step_mm[a], w};
-      sum += 2 * w;
-    }
+      sum += j == 0 ? w : 2 * w;
+    });
     for (auto& tap : taps) tap.second /= sum;
     density = spreadOver(density, table_first_mm_, taps);
   }
@@ -496,12 +496,11 @@ double curvatureShiftMm(const LineVoxels& line, const PointSpread& spread) {
       const double width_voxels = width_mm / line.spacing_mm[a];
       variance_mm2 = 0;
       if (width_voxels >= 0.1) {
-        const std::vector<double> weights = gridWeights(width_voxels);
-        double sum = weights[0], moment = 0;
-        for (size_t j = 1; j < weights.size(); ++j) {
-          sum += 2 * weights[j];
-          moment += 2 * weights[j] * static_cast<double>(j * j);
-        }
+        double sum = 0, moment = 0;
+        forEachGridWeight(width_voxels, [&](int j, double w) {
+          sum += j == 0 ? w : 2 * w;
+          moment += 2 * w * j * j;
+        });
         variance_mm2 = moment / sum * line.spacing_mm[a] * line.spacing_mm[a];
       }
     }
