@@ -200,7 +200,10 @@ double curvatureShiftMm(const LineVoxels& line, const PointSpread& spread);
 /// (tissueHeldAcrossSlices), the width within them is the one width of the
 /// lines within them (slice share below kWithinSlicesShare) instead, since
 /// the lines across long slices see the slice's own profile, which a
-/// generator or scanner may take unlike the model's box.
+/// generator or scanner may take unlike the model's box: of those lines,
+/// the ones the model explains (their residual within 1.3 times the
+/// median), and of the kind they fit better by more than the log of their
+/// voxels' count (else the common one's).
 /// There, or where the width across the slices comes out more than a tenth
 /// wider than within them, the width across the slices is then estimated
 /// again on the lines across them, each fitted with the tissue of its
