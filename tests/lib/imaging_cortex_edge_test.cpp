@@ -483,7 +483,7 @@ TEST(CortexEdge, KindWithinLongSlicesFromTheLinesWithinThem) {
   const Eigen::Vector3d normals[] = {Eigen::Vector3d(1, 0.21, 0.02), Eigen::Vector3d(0.8, -0.2, 0.5),
                                      Eigen::Vector3d(0.2, 0.3, 1)};
   std::vector<imaging::LineVoxels> lines, within;
-  std::vector<double> starts, within_starts;
+  std::vector<double> within_starts;
   unsigned seed = 41;
   for (const Eigen::Vector3d& n : normals) {
     FlatCortex plane;
@@ -499,7 +499,6 @@ TEST(CortexEdge, KindWithinLongSlicesFromTheLinesWithinThem) {
     const std::vector<imaging::LineVoxels> own = linesAcross(plane, seed++, own_starts);
     for (size_t i = 0; i < own.size(); i += 3) {  // a third of the lines: enough, in a third of the time
       lines.push_back(own[i]);
-      starts.push_back(own_starts[i]);
       if (&n != &normals[0]) continue;
       within.push_back(own[i]);
       within_starts.push_back(own_starts[i]);
