@@ -697,17 +697,28 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
     c.found = true;
     return c;
   };
-  double chosen_value = 0;  // the chosen kind's negated log-likelihood at its width
-  const auto chooseKind = [&](const std::vector<size_t>& subset) {
-    const Common scanner = commonWidth(subset, PointSpread::Kind::Scanner);
-    const Common grid = commonWidth(subset, PointSpread::Kind::VoxelGrid);
-    if (!scanner.found && !grid.found) return false;
-    const bool on_grid = grid.negated_log_likelihood < scanner.negated_log_likelihood;
-    const Common& chosen = on_grid ? grid : scanner;
-    ps.kind = on_grid ? PointSpread::Kind::VoxelGrid : PointSpread::Kind::Scanner;
-    ps.sigma_mm = ps.slice_sigma_mm = chosen.width_mm;
-    chosen_value = chosen.negated_log_likelihood;
-    return true;
+  // The kind whose one width fits `subset` better, and that width: `current`
+  // unless the other kind fits better by more than `margin` (log-likelihood).
+  struct KindFit {
+    PointSpread::Kind kind;
+    Common fit;
+  };
+  const auto chooseKind = [&](const std::vector<size_t>& subset, PointSpread::Kind current, double margin,
+                              bool flat_at_edge) {
+    const auto other_kind =
+        current == PointSpread::Kind::VoxelGrid ? PointSpread::Kind::Scanner : PointSpread::Kind::VoxelGrid;
+    const Common same = commonWidth(subset, current, flat_at_edge);
+    const Common other = commonWidth(subset, other_kind, flat_at_edge);
+    if (other.found && (!same.found || same.negated_log_likelihood - other.negated_log_likelihood > margin))
+      return KindFit{other_kind, other};
+    return KindFit{current, same};
+  };
+  // The voxels of `subset`'s lines: a likelihood's gain per extra parameter
+  // must exceed the log of their count (the Bayesian information criterion).
+  const auto voxelCount = [&](const std::vector<size_t>& subset) {
+    double voxels = 0;
+    for (const size_t i : subset) voxels += static_cast<double>(lines[i].offset_mm.size());
+    return voxels;
   };
   std::vector<size_t> every(sampled), within, across;
   for (size_t i = 0; i < lines.size(); ++i) {
@@ -718,7 +729,11 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
   for (const size_t i : every) across_share += lines[i].slice_share;
   const bool too_few_across = across_share < kMinAcrossShare * static_cast<double>(sampled);
 
-  if (!chooseKind(every)) return ps;
+  const KindFit common_fit = chooseKind(every, PointSpread::Kind::Scanner, 0.0, false);
+  if (!common_fit.fit.found) return ps;
+  ps.kind = common_fit.kind;
+  ps.sigma_mm = ps.slice_sigma_mm = common_fit.fit.width_mm;
+  const double chosen_value = common_fit.fit.negated_log_likelihood;  // at the common width
   const double common = ps.sigma_mm;
   // Voxels longer across the slices than within them: a thin cortex's
   // thickness trades against the blur on the lines across the slices (its
@@ -799,16 +814,10 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
     // common one where it fits better by more than the log of the voxels'
     // count (at a width of about a voxel the two kinds hardly differ, and
     // noise alone tips the balance by a few units).
-    const auto other_kind = ps.kind == PointSpread::Kind::VoxelGrid ? PointSpread::Kind::Scanner
-                                                                    : PointSpread::Kind::VoxelGrid;
-    const Common same = commonWidth(within, ps.kind, true), other = commonWidth(within, other_kind, true);
-    double voxels = 0;
-    for (const size_t i : within) voxels += static_cast<double>(lines[i].offset_mm.size());
-    if (other.found && (!same.found || same.negated_log_likelihood - other.negated_log_likelihood > std::log(voxels))) {
-      ps.kind = other_kind;
-      ps.sigma_mm = other.width_mm;
-    } else if (same.found) {
-      ps.sigma_mm = same.width_mm;
+    const KindFit in_plane = chooseKind(within, ps.kind, std::log(voxelCount(within)), true);
+    if (in_plane.fit.found) {
+      ps.kind = in_plane.kind;
+      ps.sigma_mm = in_plane.fit.width_mm;
     }
   } else {
     // The slice width, then the width within the slices, each searched over
@@ -833,9 +842,7 @@ PointSpread estimatePointSpread(const std::vector<LineVoxels>& all_lines, int th
         searched([&](double s) { return total(every, ps.kind, s, split.slice_sigma_mm); },
                  [&](double s) { return total(few, ps.kind, s, split.slice_sigma_mm); });
     split.sigma_mm = in_plane;
-    double voxels = 0;
-    for (const size_t i : every) voxels += static_cast<double>(lines[i].offset_mm.size());
-    if (chosen_value - split_value > std::log(voxels)) ps = split;
+    if (chosen_value - split_value > std::log(voxelCount(every))) ps = split;
   }
   ps.found = true;
   ps.held_across = tissueHeldAcrossSlices(lines.front().extent_mm, ps.sigma_mm, ps.slice_sigma_mm);
