@@ -39,7 +39,7 @@ articula_require(ITK_FOUND libinsighttoolkit5-dev)
 
 # Without a component list VTK looks for Qt5 development files.
 find_package(VTK 9.1 QUIET COMPONENTS CommonCore CommonDataModel CommonTransforms
-  FiltersCore FiltersGeneral FiltersModeling IOXML IOGeometry IOPLY IOLegacy)
+  FiltersCore FiltersGeneral FiltersModeling IOXML IOXMLParser IOGeometry IOPLY IOLegacy)
 articula_require(VTK_FOUND libvtk9-dev)
 
 # Boost.Math (headers only): the chi-square and binomial distributions of

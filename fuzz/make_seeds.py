@@ -89,9 +89,9 @@ def table_seeds():
                                            for i, (p, n) in enumerate(zip(POINTS, NORMALS)))
     write("fuzz_point_table", "named_columns.csv", CSV + text.encode())
 
-# ---- meshes (fuzz_mesh: first byte 0 .stl, 1 .obj, 2 .vtp) -------------------------------------
+# ---- meshes (fuzz_mesh: first byte 0 .stl, 1 .obj, 2 .vtp, 3 .vtk, 4 .ply) ---------------------------------
 
-STL, OBJ, VTP = b"\x00", b"\x01", b"\x02"
+STL, OBJ, VTP, LEGACY, PLY_MESH = b"\x00", b"\x01", b"\x02", b"\x03", b"\x04"
 TETRA = [(0, 0, 0), (10, 0, 0), (0, 10, 0), (0, 0, 10)]
 FACES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
 
@@ -168,6 +168,24 @@ def mesh_seeds():
   <AppendedData encoding="raw">
    _""".encode() + appended + b"\n  </AppendedData>\n</VTKFile>\n"
     write("fuzz_mesh", "appended_raw.vtp", VTP + text)
+    header = "# vtk DataFile Version 4.2\ntetrahedron\n"
+    text = header + "ASCII\nDATASET POLYDATA\nPOINTS 4 float\n" + "".join("%g %g %g\n" % v for v in TETRA)
+    text += "POLYGONS 4 16\n" + "".join("3 %d %d %d\n" % f for f in FACES)
+    text += "POINT_DATA 4\nNORMALS Normals float\n" + "".join("%g %g %g\n" % n for n in NORMALS)
+    write("fuzz_mesh", "ascii_legacy.vtk", LEGACY + text.encode())
+    data = (header + "BINARY\nDATASET POLYDATA\nPOINTS 4 double\n").encode()
+    data += b"".join(struct.pack(">3d", *v) for v in TETRA)
+    data += b"\nPOLYGONS 4 16\n" + b"".join(struct.pack(">4i", 3, *f) for f in FACES) + b"\n"
+    write("fuzz_mesh", "binary_legacy.vtk", LEGACY + data)
+    text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    text += "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
+    text += "".join("%g %g %g\n" % v for v in TETRA) + "".join("3 %d %d %d\n" % f for f in FACES)
+    write("fuzz_mesh", "ascii_mesh.ply", PLY_MESH + text.encode())
+    data = ("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+            "property double z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n").encode()
+    data += b"".join(struct.pack("<3d", *v) for v in TETRA)
+    data += b"".join(struct.pack("<B3i", 3, *f) for f in FACES)
+    write("fuzz_mesh", "binary_mesh.ply", PLY_MESH + data)
 
 # ---- fits.json -------------------------------------------------------------------------------------
 

@@ -604,6 +604,36 @@ TEST_F(PointsTest, StlThatVtkReadsAsBinaryIsCheckedForItsSize) {
   EXPECT_TRUE(contains(m, "solid_binary.stl") && contains(m, "538976288 triangles")) << m;
 }
 
+// Found by fuzzing (fuzz/fuzz_mesh): VTK took a NumberOfComponents past the
+// range of int as the largest int and ran for minutes on the array. Every
+// spelling of such a count (and of none at all) is refused, by its element.
+TEST_F(PointsTest, VtpComponentCountsOutsideAMeshsArraysAreRefused) {
+  const auto vtp = [](const std::string& components) {
+    std::string text = R"(<?xml version="1.0"?>
+<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" header_type="UInt32">
+  <PolyData>
+    <Piece NumberOfPoints="4">
+      <Points>
+        <DataArray type="Float64" NumberOfComponents=")" +
+                       components + R"(" format="appended" offset="0"/>
+      </Points>
+    </Piece>
+  </PolyData>
+  <AppendedData encoding="raw">
+   _)";
+    appendLittleEndian(text, std::uint32_t{96});
+    for (int i = 0; i < 12; ++i) appendLittleEndian(text, std::uint64_t{0x4024000000000000});  // 10.0
+    return text + "\n  </AppendedData>\n</VTKFile>\n";
+  };
+  EXPECT_EQ(readPoints(writeFile("appended.vtp", vtp("3"))).positions.rows(), 4);  // the raw data read past
+  for (const std::string& bad : {std::string(90, '5'), std::string("&#51;") + std::string(20, '5'),
+                                 std::string("0"), std::string("4097"), std::string("-3"), std::string("3x")}) {
+    const std::string m = readError(writeFile("components.vtp", vtp(bad)));
+    EXPECT_TRUE(contains(m, "components.vtp") && contains(m, "NumberOfComponents of 1 to 4096 on <DataArray>"))
+        << bad << ": " << m;
+  }
+}
+
 TEST_F(PointsTest, ReadsTheRealFemurMesh) {
   const fs::path path = sharedData() / "meshes/femur/LHDL_CT_femur_r.stl";
   if (!fs::exists(path)) GTEST_SKIP() << "real data absent: " << path;

@@ -17,6 +17,8 @@
 #include <vtkPolyData.h>
 #include <vtkSTLReader.h>
 #include <vtkSmartPointer.h>
+#include <vtkXMLDataElement.h>
+#include <vtkXMLDataParser.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
@@ -172,6 +174,43 @@ void checkObjReferences(const std::filesystem::path& path) {
   }
 }
 
+// VTK 9.1's XML readers take a DataArray's NumberOfComponents as they parse
+// it: a number past the range of int is read as the largest int, and the
+// reader then spends minutes (or all memory) on an array of that many
+// components. So the file's XML is parsed first by VTK's own parser (which
+// stops at the appended binary data and resolves character references as
+// the reader will), and every NumberOfComponents must be plain digits within
+// what a mesh's arrays hold; anything else is refused rather than guessed.
+constexpr long kMaxVtpComponents = 4096;
+
+void checkVtpComponentCounts(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot open mesh file " + quoted(path) + " for reading");
+  vtkNew<vtkXMLDataParser> parser;
+  vtkNew<ErrorCollector> ignored;  // a malformed file: the reader's own parse reports it
+  parser->AddObserver(vtkCommand::ErrorEvent, ignored);
+  parser->SetStream(&in);
+  if (!parser->Parse() || parser->GetRootElement() == nullptr) return;
+  std::vector<vtkXMLDataElement*> pending{parser->GetRootElement()};  // a stack: nesting depth is the file's
+  while (!pending.empty()) {
+    vtkXMLDataElement* element = pending.back();
+    pending.pop_back();
+    for (int i = 0; i < element->GetNumberOfNestedElements(); ++i) pending.push_back(element->GetNestedElement(i));
+    const char* value = element->GetAttribute("NumberOfComponents");
+    if (value == nullptr) continue;
+    std::string text(value);
+    const auto first = text.find_first_not_of(" \t\r\n");
+    const auto last = text.find_last_not_of(" \t\r\n");
+    text = first == std::string::npos ? "" : text.substr(first, last - first + 1);
+    const bool digits = !text.empty() && text.size() <= 9 && text.find_first_not_of("0123456789") == std::string::npos;
+    const long components = digits ? std::stol(text) : 0;
+    if (components < 1 || components > kMaxVtpComponents)
+      throw InputError("mesh file " + quoted(path) + ": expected NumberOfComponents of 1 to " +
+                       std::to_string(kMaxVtpComponents) + " on <" + element->GetName() + ">, found '" +
+                       text.substr(0, 40) + (text.size() > 40 ? "...'" : "'"));
+  }
+}
+
 vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkCommand* errors) {
   const std::string ext = lowercase(path.extension().string());
   if (ext == ".stl") {
@@ -200,6 +239,7 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
   if (ext != ".vtp")
     throw InputError("mesh file " + quoted(path) + ": expected extension .vtp, .stl, .ply, .vtk or .obj, found '" +
                      path.extension().string() + "'");
+  checkVtpComponentCounts(path);
   auto reader = vtkSmartPointer<vtkXMLPolyDataReader>::New();
   reader->SetFileName(path.c_str());
   reader->SetParserErrorObserver(errors);  // the XML parser's message names the line and column
