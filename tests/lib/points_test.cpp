@@ -16,6 +16,7 @@
 #include <string>
 
 #include "articula/core/error.hpp"
+#include "articula/points/mesh_file.hpp"
 #include "articula/points/ply_writer.hpp"
 #include "articula/points/point_io.hpp"
 
@@ -23,6 +24,8 @@ namespace fs = std::filesystem;
 using articula::InputError;
 using articula::UsageError;
 using articula::points::checkFittable;
+using articula::points::MeshFile;
+using articula::points::readMeshFile;
 using articula::points::PointCloud;
 using articula::points::readPoints;
 using articula::points::writePoints;
@@ -631,6 +634,52 @@ TEST_F(PointsTest, VtpComponentCountsOutsideAMeshsArraysAreRefused) {
     const std::string m = readError(writeFile("components.vtp", vtp(bad)));
     EXPECT_TRUE(contains(m, "components.vtp") && contains(m, "NumberOfComponents of 1 to 4096 on <DataArray>"))
         << bad << ": " << m;
+  }
+}
+
+// PLY meshes go through the project's PLY reader, as PLY points do (VTK 9.1's
+// reader crashed on a face record shorter than its list, found by fuzzing).
+TEST_F(PointsTest, ReadsPlyMeshFacesAndRefusesShortOrStrayFaces) {
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
+                             "property double z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+                             "element face 2\nproperty uchar flags\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string vertices = "0 0 0 0 0 2\n10 0 0 0 0 1\n10 10 0 0 0 1\n0 10 0 0 0 1\n5 5 0.125 0 0 1\n";
+  const MeshFile mesh = readMeshFile(writeFile("quad.ply", header + vertices + "7 4 0 1 2 3\n0 3 0 1 4\n"));
+  ASSERT_EQ(mesh.vertices.rows(), 5);
+  EXPECT_EQ(mesh.vertices.row(4), Eigen::RowVector3d(5, 5, 0.125));  // doubles kept
+  ASSERT_EQ(mesh.normals.rows(), 5);
+  EXPECT_EQ(mesh.normals.row(0), Eigen::RowVector3d(0, 0, 1));  // at unit length
+  ASSERT_EQ(mesh.triangles.rows(), 3);  // the quad in two, then the triangle
+  EXPECT_EQ(mesh.triangles.row(2), Eigen::RowVector3i(0, 1, 4));
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"7 4 0 1\n0 3 0 1 4\n", "line 19 (face record): expected item 2 of list 'vertex_indices', found the end of the line"},
+      {"7 4 0 1 2 5\n0 3 0 1 4\n", "line 19 (face 0, 0-based): expected vertex indices from 0 to 4, found 5"},
+      {"7 4 0 1 2 3\n0 3 0 -1 4\n", "(face 1, 0-based): expected vertex indices from 0 to 4, found -1"},
+      {"7 4 0 1 2 3\n", "expected 2 face records, found the end of the file after 1"}};
+  for (const auto& [faces, expected] : bad) {
+    try {
+      readMeshFile(writeFile("bad.ply", header + vertices + faces));
+      ADD_FAILURE() << "nothing thrown for " << faces;
+    } catch (const InputError& e) {
+      EXPECT_TRUE(contains(e.what(), "bad.ply") && contains(e.what(), expected)) << e.what();
+    }
+  }
+  // Binary, big-endian, the faces' list named vertex_index.
+  std::string binary = "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                       "property float z\nelement face 1\nproperty list uchar uint vertex_index\nend_header\n";
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) appendBigEndian(binary, v);
+  binary += '\x03';
+  for (std::uint32_t i : {2u, 1u, 0u}) appendBigEndian(binary, i);
+  const MeshFile tri = readMeshFile(writeFile("tri.ply", binary));
+  ASSERT_EQ(tri.triangles.rows(), 1);
+  EXPECT_EQ(tri.triangles.row(0), Eigen::RowVector3i(2, 1, 0));
+  appendBigEndian(binary.erase(binary.size() - 4), std::uint32_t{3});
+  try {
+    readMeshFile(writeFile("stray.ply", binary));
+    ADD_FAILURE() << "nothing thrown for a face naming vertex 3 of 3";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(contains(e.what(), "binary data (face 0, 0-based): expected vertex indices from 0 to 2, found 3"))
+        << e.what();
   }
 }
 

@@ -1,14 +1,17 @@
-// Meshes (.stl, .obj, .vtp, .vtk, .ply) through VTK's readers. VTK reports problems through
-// error events rather than exceptions, so an observer on the reader, its executive and (for XML)
-// its parser collects them, keeps them off stderr, and we throw InputError with the first one.
+// Meshes (.stl, .obj, .vtp, .vtk) through VTK's readers, and .ply through the project's
+// own PLY reader (ply_reader.cpp: VTK 9.1's crashes on a short ASCII face record). VTK
+// reports problems through error events rather than exceptions, so an observer on the
+// reader, its executive and (for XML) its parser collects them, keeps them off stderr, and
+// we throw InputError with the first one.
 #include <vtkVersion.h>
 #include <vtkAlgorithm.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkIdTypeArray.h>
 #include <vtkExecutive.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
-#include <vtkPLYReader.h>
 #include <vtkPolyDataReader.h>
 #include <vtkTriangleFilter.h>
 #include <vtkCellArray.h>
@@ -231,11 +234,6 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
     reader->SetFileName(path.c_str());
     return reader;
   }
-  if (ext == ".ply") {  // a mesh's faces (point files go through ply_reader.cpp)
-    auto reader = vtkSmartPointer<vtkPLYReader>::New();
-    reader->SetFileName(path.c_str());
-    return reader;
-  }
   if (ext != ".vtp")
     throw InputError("mesh file " + quoted(path) + ": expected extension .vtp, .stl, .ply, .vtk or .obj, found '" +
                      path.extension().string() + "'");
@@ -244,6 +242,37 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
   reader->SetFileName(path.c_str());
   reader->SetParserErrorObserver(errors);  // the XML parser's message names the line and column
   return reader;
+}
+
+// A PLY mesh as VTK's polygons, for meshFromPolyData to triangulate as it does every mesh's.
+vtkSmartPointer<vtkPolyData> plyPolyData(const std::filesystem::path& path) {
+  const PlyMesh ply = readPlyMesh(path);
+  const Eigen::Index n = ply.cloud.positions.rows();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    points->SetPoint(i, ply.cloud.positions(i, 0), ply.cloud.positions(i, 1), ply.cloud.positions(i, 2));
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  poly->SetPoints(points);
+  if (ply.cloud.normals.rows() == n) {
+    vtkNew<vtkDoubleArray> normals;
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      normals->SetTuple3(i, ply.cloud.normals(i, 0), ply.cloud.normals(i, 1), ply.cloud.normals(i, 2));
+    poly->GetPointData()->SetNormals(normals);
+  }
+  vtkNew<vtkIdTypeArray> offsets, connectivity;
+  offsets->SetNumberOfValues(static_cast<vtkIdType>(ply.face_offsets.size()));
+  for (size_t i = 0; i < ply.face_offsets.size(); ++i) offsets->SetValue(static_cast<vtkIdType>(i), ply.face_offsets[i]);
+  connectivity->SetNumberOfValues(static_cast<vtkIdType>(ply.face_indices.size()));
+  for (size_t i = 0; i < ply.face_indices.size(); ++i)
+    connectivity->SetValue(static_cast<vtkIdType>(i), ply.face_indices[i]);
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(offsets, connectivity);
+  poly->SetPolys(polys);
+  return poly;
 }
 
 }  // namespace
@@ -263,6 +292,7 @@ MeshFile readMeshFile(const std::filesystem::path& path) {
   using detail::quoted;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file " + quoted(path) + " not found");
+  if (detail::lowercase(path.extension().string()) == ".ply") return meshFromPolyData(detail::plyPolyData(path));
   vtkNew<detail::ErrorCollector> errors;
   vtkSmartPointer<vtkAlgorithm> reader = detail::makeReader(path, errors);
   for (vtkObject* source : {static_cast<vtkObject*>(reader), static_cast<vtkObject*>(reader->GetExecutive())}) {

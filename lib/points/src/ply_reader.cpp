@@ -1,10 +1,13 @@
 // PLY point files, hand-written rather than vtkPLYReader because VTK 9.1's reader
 // (1) converts every vertex property to float, so double coordinates do not round-trip;
 // (2) reports malformed headers and truncated data through VTK's error output, without the line.
-// Reading the header and the elements up to the vertex element is short code.
+// (3) (for meshes) reads a malformed ASCII record past its end: a face line with fewer
+// items than its list length crashed it (a null token to strtod).
+// Reading the header and the elements up to the vertex (and face) element is short code.
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstddef>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -253,9 +256,11 @@ void store(PointCloud& cloud, const VertexLayout& layout, Eigen::Index row, cons
   }
 }
 
-// Values of one ASCII record (one line) of `element`, scalars only kept for the vertex element.
+// Values of one ASCII record (one line) of `element`, scalars only kept for the vertex element;
+// the items of the list property `list` (an index into the properties) go to `items`.
 std::vector<double> parseAsciiRecord(const std::string& line, const Element& element,
-                                     const std::filesystem::path& path, long line_number) {
+                                     const std::filesystem::path& path, long line_number,
+                                     std::size_t list = SIZE_MAX, std::vector<double>* items = nullptr) {
   auto fail = [&](const std::string& expected, const std::string& found) {
     return InputError(quoted(path) + ", line " + std::to_string(line_number) + " (" + element.name +
                       " record): expected " + expected + ", found " + found);
@@ -276,7 +281,8 @@ std::vector<double> parseAsciiRecord(const std::string& line, const Element& ele
     cursor = end;
     return value;
   };
-  for (const Property& p : element.properties) {
+  for (std::size_t k = 0; k < element.properties.size(); ++k) {
+    const Property& p = element.properties[k];
     if (!p.is_list) {
       values.push_back(next("a number for property '" + p.name + "'"));
       continue;
@@ -285,8 +291,10 @@ std::vector<double> parseAsciiRecord(const std::string& line, const Element& ele
     // Negated so that NaN fails too, before any conversion to an integer.
     if (!(count >= 0 && count <= 1e9) || count != std::floor(count))
       throw fail("a non-negative integer list length", std::to_string(count));
-    for (long j = 0; j < static_cast<long>(count); ++j)
-      next("item " + std::to_string(j) + " of list '" + p.name + "'");
+    for (long j = 0; j < static_cast<long>(count); ++j) {
+      const double item = next("item " + std::to_string(j) + " of list '" + p.name + "'");
+      if (k == list) items->push_back(item);
+    }
     values.push_back(0.0);  // lists are skipped; keep indices aligned with properties
   }
   while (*cursor == ' ' || *cursor == '\t' || *cursor == '\r') ++cursor;
@@ -296,8 +304,36 @@ std::vector<double> parseAsciiRecord(const std::string& line, const Element& ele
   return values;
 }
 
+// The face element's vertex index lists, read alongside the vertices (meshes only).
+struct FaceLists {
+  std::size_t element = 0, property = 0;  // the face element, and its vertex_indices list
+  std::size_t vertex_count = 0;
+  std::vector<std::int64_t> offsets{0}, indices;
+
+  // Ends face `record`'s list: every item a vertex the file has.
+  void close(const std::vector<double>& items, std::size_t record, const std::filesystem::path& path,
+             const std::string& where) {
+    for (const double item : items) {
+      if (!(item >= 0 && item < static_cast<double>(vertex_count)) || item != std::floor(item)) {
+        std::ostringstream found;
+        found << item;
+        throw InputError(quoted(path) + ", " + where + " (face " + std::to_string(record) +
+                         ", 0-based): expected vertex indices from 0 to " + std::to_string(vertex_count - 1) +
+                         ", found " + found.str());
+      }
+      indices.push_back(static_cast<std::int64_t>(item));
+    }
+    offsets.push_back(static_cast<std::int64_t>(indices.size()));
+  }
+};
+
+// The last element a reading needs: the vertices', or the faces' if later.
+std::size_t lastElement(std::size_t vertex_index, const FaceLists* faces) {
+  return faces ? std::max(vertex_index, faces->element) : vertex_index;
+}
+
 PointCloud readAscii(std::istream& in, const Header& header, std::size_t vertex_index, const VertexLayout& layout,
-                     const std::filesystem::path& path, std::uintmax_t data_bytes) {
+                     const std::filesystem::path& path, std::uintmax_t data_bytes, FaceLists* faces) {
   const Element& vertex = header.elements[vertex_index];
   // Every ASCII record takes at least two bytes, which bounds an absurd declared count before allocating.
   if (vertex.count > data_bytes / 2)
@@ -321,11 +357,19 @@ PointCloud readAscii(std::istream& in, const Header& header, std::size_t vertex_
       if (line.find_first_not_of(" \t\r") != std::string::npos) return;  // blank lines carry no record
     }
   };
-  for (std::size_t e = 0; e <= vertex_index; ++e) {
+  if (faces && header.elements[faces->element].count > data_bytes / 2)
+    throw InputError(quoted(path) + ": header declares " + std::to_string(header.elements[faces->element].count) +
+                     " faces, but the data has only " + std::to_string(data_bytes) + " bytes");
+  std::vector<double> items;
+  for (std::size_t e = 0; e <= lastElement(vertex_index, faces); ++e) {
     const Element& element = header.elements[e];
+    const bool face = faces && e == faces->element;
     for (std::size_t r = 0; r < element.count; ++r) {
       nextRecord(element, r);
-      const auto values = parseAsciiRecord(line, element, path, line_number);
+      items.clear();
+      const auto values =
+          parseAsciiRecord(line, element, path, line_number, face ? faces->property : SIZE_MAX, &items);
+      if (face) faces->close(items, r, path, "line " + std::to_string(line_number));
       if (e != vertex_index) continue;
       store(cloud, layout, static_cast<Eigen::Index>(r), values);
       lines[r] = line_number;
@@ -337,7 +381,7 @@ PointCloud readAscii(std::istream& in, const Header& header, std::size_t vertex_
 }
 
 PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex_index, const VertexLayout& layout,
-                      const std::filesystem::path& path, std::uintmax_t data_bytes) {
+                      const std::filesystem::path& path, std::uintmax_t data_bytes, FaceLists* faces) {
   const Element& vertex = header.elements[vertex_index];
   std::size_t vertex_record_bytes = 0;
   for (const Property& p : vertex.properties)
@@ -357,9 +401,10 @@ PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex
   const auto n = static_cast<Eigen::Index>(vertex.count);
   cloud.positions.resize(n, 3);
   cloud.normals.resize(layout.has_normals ? n : 0, 3);
-  std::vector<double> values;
-  for (std::size_t e = 0; e <= vertex_index; ++e) {
+  std::vector<double> values, items;
+  for (std::size_t e = 0; e <= lastElement(vertex_index, faces); ++e) {
     const Element& element = header.elements[e];
+    const bool face = faces && e == faces->element;
     // Records without properties take no bytes: nothing to skip, and a declared
     // count of 10^19 of them must not be counted through one by one.
     if (element.properties.empty()) continue;
@@ -372,7 +417,9 @@ PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex
         return *value;
       };
       values.clear();
-      for (const Property& p : element.properties) {
+      items.clear();
+      for (std::size_t k = 0; k < element.properties.size(); ++k) {
+        const Property& p = element.properties[k];
         if (!p.is_list) {
           values.push_back(take(p.type));
           continue;
@@ -381,9 +428,13 @@ PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex
         if (count < 0)
           throw InputError(quoted(path) + ": " + element.name + " " + std::to_string(r) +
                            ": expected a non-negative list length, found " + std::to_string(count));
-        for (long j = 0; j < static_cast<long>(count); ++j) take(p.type);
+        for (long j = 0; j < static_cast<long>(count); ++j) {
+          const double item = take(p.type);
+          if (face && k == faces->property) items.push_back(item);
+        }
         values.push_back(0.0);
       }
+      if (face) faces->close(items, r, path, "binary data");
       if (e == vertex_index) store(cloud, layout, static_cast<Eigen::Index>(r), values);
     }
   }
@@ -393,7 +444,10 @@ PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex
 
 }  // namespace
 
-PointCloud readPly(const std::filesystem::path& path) {
+namespace {
+
+// The vertices (and, given `faces`, the face lists) of a PLY file.
+PointCloud readPlyFile(const std::filesystem::path& path, bool with_faces, FaceLists& faces) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("cannot open point file " + quoted(path) + " for reading");
   const Header header = readHeader(in, path);
@@ -406,11 +460,44 @@ PointCloud readPly(const std::filesystem::path& path) {
   const VertexLayout layout = vertexLayout(*vertex, path);
   if (vertex->count == 0) throw InputError("point file " + quoted(path) + ": expected points, found 0 vertices");
 
+  FaceLists* reading_faces = nullptr;
+  const auto face = std::find_if(header.elements.begin(), header.elements.end(),
+                                 [](const Element& e) { return e.name == "face"; });
+  if (with_faces && face != header.elements.end()) {
+    const auto list = std::find_if(face->properties.begin(), face->properties.end(), [](const Property& p) {
+      return p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
+    });
+    if (list == face->properties.end())
+      throw InputError("PLY header of " + quoted(path) +
+                       ": expected the face element to list 'vertex_indices' (or 'vertex_index'), found no such list");
+    faces.element = static_cast<std::size_t>(face - header.elements.begin());
+    faces.property = static_cast<std::size_t>(list - face->properties.begin());
+    faces.vertex_count = vertex->count;
+    reading_faces = &faces;
+  }
+
   const auto data_start = static_cast<std::uintmax_t>(in.tellg());
   const std::uintmax_t file_bytes = std::filesystem::file_size(path);
   const std::uintmax_t data_bytes = file_bytes > data_start ? file_bytes - data_start : 0;
-  return header.format == Format::Ascii ? readAscii(in, header, vertex_index, layout, path, data_bytes)
-                                        : readBinary(in, header, vertex_index, layout, path, data_bytes);
+  return header.format == Format::Ascii
+             ? readAscii(in, header, vertex_index, layout, path, data_bytes, reading_faces)
+             : readBinary(in, header, vertex_index, layout, path, data_bytes, reading_faces);
+}
+
+}  // namespace
+
+PointCloud readPly(const std::filesystem::path& path) {
+  FaceLists unused;
+  return readPlyFile(path, false, unused);
+}
+
+PlyMesh readPlyMesh(const std::filesystem::path& path) {
+  FaceLists faces;
+  PlyMesh mesh;
+  mesh.cloud = readPlyFile(path, true, faces);
+  mesh.face_offsets = std::move(faces.offsets);
+  mesh.face_indices = std::move(faces.indices);
+  return mesh;
 }
 
 }  // namespace articula::points::detail

@@ -1,8 +1,10 @@
 #pragma once
 // Internal: one reader per file family, and the checks they share.
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "articula/points/point_io.hpp"
 
@@ -10,6 +12,14 @@ namespace articula::points::detail {
 
 /// Hand-written PLY reader (see ply_reader.cpp for why not vtkPLYReader).
 PointCloud readPly(const std::filesystem::path& path);
+/// A PLY mesh, by the same reader: its vertices (and normals), and its faces'
+/// vertex indices (0-based, each a vertex the file has), face i's at
+/// face_indices[face_offsets[i] .. face_offsets[i + 1]).
+struct PlyMesh {
+  PointCloud cloud;
+  std::vector<std::int64_t> face_offsets{0}, face_indices;
+};
+PlyMesh readPlyMesh(const std::filesystem::path& path);
 /// Delimited text: .csv, .xyz, .txt.
 PointCloud readTable(const std::filesystem::path& path);
 /// Vertices (and point normals, if any) of .stl, .obj, .vtp meshes through VTK.

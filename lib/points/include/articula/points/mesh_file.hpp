@@ -1,7 +1,8 @@
 #pragma once
 // The project's one reader of mesh files (.stl, .obj, .vtp, .vtk, .ply),
 // through VTK's readers with their errors collected instead of printed and
-// the checks VTK does not make (a binary STL's size, an OBJ's indices): the
+// the checks VTK does not make (a binary STL's size, an OBJ's indices, a
+// .vtp's component counts), and .ply through the project's PLY reader: the
 // mesh stage's input and the vertices a point file may be. Eigen out, VTK
 // stays inside lib/points.
 #include <filesystem>
