@@ -177,6 +177,32 @@ def mesh_seeds():
     data += b"".join(struct.pack(">3d", *v) for v in TETRA)
     data += b"\nPOLYGONS 4 16\n" + b"".join(struct.pack(">4i", 3, *f) for f in FACES) + b"\n"
     write("fuzz_mesh", "binary_legacy.vtk", LEGACY + data)
+    # Version 5.1 as vtkPolyDataWriter writes it: offsets and connectivity, a strip, field and cell
+    # data, CutThroughBone as colour scalars, and METADATA after the normals.
+    header = "# vtk DataFile Version 5.1\ntetrahedron\n"
+    field = "FIELD FieldData 1\nNames 1 2 string\n"
+    text = header + "ASCII\nDATASET POLYDATA\n" + field + "left%20hip\n\n"
+    text += "POINTS 4 float\n" + "".join("%g %g %g\n" % v for v in TETRA)
+    text += "METADATA\nINFORMATION 1\nNAME L2_NORM_RANGE LOCATION vtkDataArray\nDATA 2 0 10\n\n"
+    text += "POLYGONS 3 6\nOFFSETS vtktypeint64\n0 3 6\nCONNECTIVITY vtktypeint64\n0 2 1 0 1 3\n"
+    text += "TRIANGLE_STRIPS 2 4\nOFFSETS vtktypeint64\n0 4\nCONNECTIVITY vtktypeint64\n0 3 2 1\n"
+    text += "CELL_DATA 3\nSCALARS CellId int 1\nLOOKUP_TABLE default\n0 1 2\n"
+    text += "POINT_DATA 4\nCOLOR_SCALARS CutThroughBone 1\n0 1 0 0.00392157\n"
+    text += "NORMALS Normals float\n" + "".join("%g %g %g\n" % n for n in NORMALS)
+    text += "METADATA\nCOMPONENT_NAMES\nx\ny\nz\n\nFIELD FieldData 1\nExtra 2 4 double\n0 1 2 3 4 5 6 7\n"
+    write("fuzz_mesh", "ascii_legacy_51.vtk", LEGACY + text.encode())
+    data = (header + "BINARY\nDATASET POLYDATA\n" + field).encode() + b"\xc8left hip\xc0\n"
+    data += b"POINTS 4 double\n" + b"".join(struct.pack(">3d", *v) for v in TETRA)
+    data += b"\nPOLYGONS 3 6\nOFFSETS vtktypeint64\n" + struct.pack(">3q", 0, 3, 6)
+    data += b"\nCONNECTIVITY vtktypeint64\n" + struct.pack(">6q", 0, 2, 1, 0, 1, 3)
+    data += b"\nTRIANGLE_STRIPS 2 4\nOFFSETS vtktypeint64\n" + struct.pack(">2q", 0, 4)
+    data += b"\nCONNECTIVITY vtktypeint64\n" + struct.pack(">4q", 0, 3, 2, 1)
+    data += b"\nCELL_DATA 3\nSCALARS CellId int 1\nLOOKUP_TABLE default\n" + struct.pack(">3i", 0, 1, 2)
+    data += b"\nPOINT_DATA 4\nCOLOR_SCALARS CutThroughBone 1\n" + bytes([0, 1, 0, 1])
+    data += b"\nNORMALS Normals float\n" + b"".join(struct.pack(">3f", *n) for n in NORMALS)
+    data += b"\nMETADATA\nCOMPONENT_NAMES\nx\ny\nz\n\nFIELD FieldData 1\nExtra 2 4 double\n"
+    data += struct.pack(">8d", *range(8)) + b"\n"
+    write("fuzz_mesh", "binary_legacy_51.vtk", LEGACY + data)
     text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
     text += "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
     text += "".join("%g %g %g\n" % v for v in TETRA) + "".join("3 %d %d %d\n" % f for f in FACES)

@@ -1,6 +1,21 @@
 // Tests for lib/points: point-file reading and writing, and the fittability checks.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkFloatArray.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataReader.h>
+#include <vtkPolyDataWriter.h>
+#include <vtkStringArray.h>
+#include <vtkTriangleFilter.h>
+#include <vtkUnsignedCharArray.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -680,6 +695,294 @@ TEST_F(PointsTest, ReadsPlyMeshFacesAndRefusesShortOrStrayFaces) {
   } catch (const InputError& e) {
     EXPECT_TRUE(contains(e.what(), "binary data (face 0, 0-based): expected vertex indices from 0 to 2, found 3"))
         << e.what();
+  }
+}
+
+// ---- legacy .vtk meshes ---------------------------------------------------------------------------------
+
+// The InputError message of readMeshFile(path); fails the test if anything else happens.
+std::string meshError(const fs::path& path) {
+  try {
+    readMeshFile(path);
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected InputError reading " << path << ", nothing thrown";
+  return {};
+}
+
+// Six points, a quad and a triangle, a triangle strip, float point normals (with component
+// names, so VTK writes METADATA after them), CutThroughBone as the active scalars or as a
+// plain point array, and arrays to read past: scalars, field data, cell data, strings.
+vtkSmartPointer<vtkPolyData> legacyTestMesh(bool cut_as_scalars) {
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (int i = 0; i < 6; ++i) points->InsertNextPoint(0.1 * i - 12.5, 1.0 / 3.0 + i, std::sqrt(2.0 + i) * 1e3);
+  poly->SetPoints(points);
+  vtkNew<vtkCellArray> polys, strips;
+  polys->InsertNextCell({0, 1, 2, 3});
+  polys->InsertNextCell({1, 2, 4});
+  strips->InsertNextCell({0, 1, 4, 5, 2});
+  poly->SetPolys(polys);
+  poly->SetStrips(strips);
+  vtkNew<vtkFloatArray> normals;
+  normals->SetName("Normals");
+  normals->SetNumberOfComponents(3);
+  for (int i = 0; i < 6; ++i) {
+    const Eigen::Vector3f n = Eigen::Vector3f(std::cos(0.3f * i), std::sin(0.7f * i), 0.2f + i).normalized();
+    normals->InsertNextTuple3(n.x(), n.y(), n.z());
+  }
+  normals->SetComponentName(0, "n x");
+  double range[2];
+  normals->GetRange(range, -1);  // cached as an information key: written as METADATA INFORMATION
+  poly->GetPointData()->SetNormals(normals);
+  vtkNew<vtkUnsignedCharArray> cut;
+  cut->SetName("CutThroughBone");
+  for (int i = 0; i < 6; ++i) cut->InsertNextValue(i % 3 == 1 ? 1 : 0);
+  vtkNew<vtkDoubleArray> extra;
+  extra->SetName("Extra");
+  for (int i = 0; i < 6; ++i) extra->InsertNextValue(i * 0.5);
+  poly->GetPointData()->SetScalars(cut_as_scalars ? static_cast<vtkDataArray*>(cut) : extra);
+  poly->GetPointData()->AddArray(cut_as_scalars ? static_cast<vtkDataArray*>(extra) : cut);
+  vtkNew<vtkIntArray> cell_ids;
+  cell_ids->SetName("CellId");
+  for (int i = 0; i < 3; ++i) cell_ids->InsertNextValue(i);
+  poly->GetCellData()->SetScalars(cell_ids);
+  vtkNew<vtkStringArray> names;
+  names->SetName("Names");
+  names->InsertNextValue("left hip");
+  names->InsertNextValue("");
+  poly->GetFieldData()->AddArray(names);
+  return poly;
+}
+
+// What VTK's own reader and triangle filter made of a file.
+MeshFile readWithVtk(const fs::path& path) {
+  vtkNew<vtkPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkNew<vtkTriangleFilter> triangulate;
+  triangulate->SetInputConnection(reader->GetOutputPort());
+  triangulate->PassVertsOff();
+  triangulate->PassLinesOff();
+  triangulate->Update();
+  vtkPolyData* poly = reader->GetOutput();
+  MeshFile out;
+  const vtkIdType n = poly->GetNumberOfPoints();
+  out.vertices.resize(n, 3);
+  out.normals.resize(n, 3);
+  for (vtkIdType i = 0; i < n; ++i) {
+    double p[3], v[3];
+    poly->GetPoint(i, p);
+    poly->GetPointData()->GetNormals()->GetTuple(i, v);
+    out.vertices.row(i) << p[0], p[1], p[2];
+    out.normals.row(i) << v[0], v[1], v[2];
+    out.cut_through_bone.push_back(poly->GetPointData()->GetArray("CutThroughBone")->GetTuple1(i) != 0 ? 1 : 0);
+  }
+  vtkCellArray* triangles = triangulate->GetOutput()->GetPolys();
+  out.triangles.resize(triangles->GetNumberOfCells(), 3);
+  vtkIdType row = 0, count = 0;
+  const vtkIdType* ids = nullptr;
+  for (triangles->InitTraversal(); triangles->GetNextCell(count, ids); ++row)
+    out.triangles.row(row) << static_cast<int>(ids[0]), static_cast<int>(ids[1]), static_cast<int>(ids[2]);
+  return out;
+}
+
+// Legacy .vtk meshes go through the project's reader (VTK 9.1's crashed on a malformed
+// header): what vtkPolyDataWriter writes, ASCII and binary, in the 5.1 layout (offsets and
+// connectivity) and the 4.2 one (counts and ids), reads as VTK's own reader reads it.
+TEST_F(PointsTest, ReadsLegacyVtkAsVtkDoesInEveryLayout) {
+  const vtkSmartPointer<vtkPolyData> written = legacyTestMesh(false);
+  for (const bool cut_as_scalars : {false, true}) {
+    const vtkSmartPointer<vtkPolyData> source = legacyTestMesh(cut_as_scalars);
+    for (const int version : {int{vtkPolyDataWriter::VTK_LEGACY_READER_VERSION_5_1},
+                              int{vtkPolyDataWriter::VTK_LEGACY_READER_VERSION_4_2}}) {
+      for (const bool binary : {false, true}) {
+        const std::string label = std::string(binary ? "binary" : "ascii") + "_" + std::to_string(version) +
+                                  (cut_as_scalars ? "_scalars" : "_field");
+        const fs::path path = file(label + ".vtk");
+        vtkNew<vtkPolyDataWriter> writer;
+        writer->SetInputData(source);
+        writer->SetFileVersion(version);
+        if (binary) writer->SetFileTypeToBinary();
+        writer->SetFileName(path.c_str());
+        ASSERT_EQ(writer->Write(), 1) << label;
+
+        const MeshFile mesh = readMeshFile(path);
+        const MeshFile vtk = readWithVtk(path);
+        SCOPED_TRACE(label);
+        expectBitwiseEqual(mesh.vertices, vtk.vertices);
+        expectBitwiseEqual(mesh.normals, vtk.normals);
+        EXPECT_EQ(mesh.triangles, vtk.triangles);
+        EXPECT_EQ(mesh.cut_through_bone, vtk.cut_through_bone);
+        // And the known values: binary doubles exactly, the quad in two, then the strip's triangles.
+        if (binary) {
+          for (vtkIdType i = 0; i < 6; ++i) {
+            double p[3];
+            written->GetPoint(i, p);
+            EXPECT_EQ(mesh.vertices.row(i), Eigen::RowVector3d(p[0], p[1], p[2])) << i;
+          }
+        }
+        ASSERT_EQ(mesh.triangles.rows(), 6);
+        EXPECT_EQ(mesh.triangles.row(2), Eigen::RowVector3i(1, 2, 4));
+        EXPECT_EQ(mesh.triangles.row(3), Eigen::RowVector3i(0, 1, 4));
+        EXPECT_EQ(mesh.triangles.row(4), Eigen::RowVector3i(4, 1, 5));
+        EXPECT_EQ(mesh.triangles.row(5), Eigen::RowVector3i(4, 5, 2));
+        EXPECT_EQ(mesh.cut_through_bone, (std::vector<unsigned char>{0, 1, 0, 0, 1, 0}));
+      }
+    }
+  }
+}
+
+// Hand-written: lower-case keywords, CRLF line ends, and every attribute VTK knows, read past.
+TEST_F(PointsTest, ReadsLegacyVtkPastEveryAttribute) {
+  const std::string text =
+      "# vtk DataFile Version 3.0\r\nany title at all\r\nascii\r\ndataset polydata\r\n"
+      "points 4 float\r\n0 0 0 1 0 0 1 1 0 0 1 0.5\r\nvertices 1 2\r\n1 3\r\nlines 1 3\r\n2 0 2\r\n"
+      "polygons 1 5\r\n4 0 1 2 3\r\ncell_data 3\r\ncolor_scalars rgb 3\r\n1 0 0 0 1 0 0 0 1\r\n"
+      "point_data 4\r\nscalars temperature%20C float 2\r\nlookup_table heat\r\n1 2 3 4 5 6 7 8\r\n"
+      "lookup_table heat 2\r\n0 0 0 1 1 1 1 1\r\nvectors v double\r\n1 2 3 4 5 6 7 8 9 10 11 12\r\n"
+      "texture_coordinates uv 2 float\r\n0 0 1 0 1 1 0 1\r\ntensors6 t float\r\n"
+      "1 2 3 4 5 6 1 2 3 4 5 6 1 2 3 4 5 6 1 2 3 4 5 6\r\nglobal_ids ids vtkidtype\r\n0 1 2 3\r\n"
+      "field extras 3\r\nNULL_ARRAY\r\nnames 1 4 string\r\na\r\nb c\r\n\r\nd\r\n"
+      "CutThroughBone 1 4 int\r\n0 1 1 0\r\nMETADATA\r\nINFORMATION 1\r\nNAME L2_NORM_RANGE LOCATION vtkDataArray\r\n"
+      "DATA 2 0 1\r\n\r\nnormals n float\r\n0 0 1 0 0 1 0 0 1 0 0 1\r\n";
+  const fs::path path = writeFile("every.vtk", text);
+  const MeshFile mesh = readMeshFile(path);
+  ASSERT_EQ(mesh.vertices.rows(), 4);
+  EXPECT_EQ(mesh.vertices.row(3), Eigen::RowVector3d(0, 1, 0.5));
+  ASSERT_EQ(mesh.normals.rows(), 4);
+  EXPECT_EQ(mesh.normals.row(2), Eigen::RowVector3d(0, 0, 1));
+  EXPECT_EQ(mesh.triangles.rows(), 2);
+  EXPECT_EQ(mesh.cut_through_bone, (std::vector<unsigned char>{0, 1, 1, 0}));
+  const MeshFile vtk = readWithVtk(path);  // VTK reads the same file the same way
+  EXPECT_EQ(mesh.vertices, vtk.vertices);
+  EXPECT_EQ(mesh.triangles, vtk.triangles);
+  EXPECT_EQ(mesh.cut_through_bone, vtk.cut_through_bone);
+}
+
+// Found by fuzzing (fuzz/fuzz_mesh): VTK 9.1's reader crashed (in vtkDataReader::ReadString)
+// on this file, whose version line is malformed and whose polygons hold NUL bytes.
+TEST_F(PointsTest, LegacyVtkThatCrashedVtksReaderIsRefused) {
+  const std::string head = "# vtk DataFile Version\xff\xff 4.2\ntetrahedron\n";
+  const std::string body =
+      "ASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0\n10 0 0\n0 10 0\n0 0 10\nPOLYGONS 4 16\n3 0 2 1\n3 0 1 3\n" +
+      std::string(43, '\0') +
+      "3 0 3 2\n3 1 2 3\nPOINT_DATA 4\nNORMend_headerA\xff\xff\xff\xff\xff\xff\xff\xffL1\nf 1/1/<VTKFile2 -1\n"
+      "vn 0 -10 1 0\n0.6 0.8 0\n";
+  std::string m = meshError(writeFile("crash.vtk", head + body));
+  EXPECT_TRUE(contains(m,
+                       "crash.vtk', line 1: expected '# vtk DataFile Version x.y' of 1.0 to 5.1, found "
+                       "'# vtk DataFile Version\\xff\\xff 4.2'"))
+      << m;
+  m = meshError(writeFile("nul.vtk", "# vtk DataFile Version 4.2\ntetrahedron\n" + body));
+  EXPECT_TRUE(contains(m,
+                       "nul.vtk', line 13: expected an integer in the range of its type for POLYGONS, found "
+                       "'\\x00\\x00"))
+      << m;
+}
+
+// Truncated files, indices past the points, counts past the file and inconsistent cells are
+// refused by line (ASCII) or byte (BINARY), before anything is allocated for them.
+TEST_F(PointsTest, MalformedLegacyVtkIsRefusedWithWhereAndWhat) {
+  const std::string head = "# vtk DataFile Version 4.2\nmesh\nASCII\nDATASET POLYDATA\n";
+  const std::string points = "POINTS 4 float\n0 0 0\n10 0 0\n0 10 0\n0 0 10\n";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {head + points + "POLYGONS 1 4\n3 0 1 7\n",
+       "line 10 (POLYGONS, cell 0, 0-based): expected point indices from 0 "
+       "to 3, found 7"},
+      {head + "POINTS 4000000000 float\n0 0 0\n" + std::string(150, ' '),
+       "line 5: expected 12000000000 values for POINTS within the 157 bytes left, found too few bytes"},
+      {head + points.substr(0, 30),
+       "line 5: expected 12 values for POINTS within the 16 bytes left, found too few bytes (truncated file?)"},
+      {head + points + "POLYGONS 2 8\n3 0 1 2\n3 0 1\n",
+       "line 13: expected an integer for POLYGONS, found the end of the "
+       "file"},
+      {head + points + "POLYGONS 2 8\n3 0 1 2\n4 0 1 2\n",
+       "line 10 (POLYGONS): expected cell 1 (0-based) to list at "
+       "most the 3 integers left of 8, found a point count of 4"},
+      {head + points + "POLYGONS 3 8\n3 0 1 2\n3 0 1 3\n", "expected 3 cells as declared, found 2"},
+      {head + "POINTS 1 float\n0 0.5x 0\n", "line 6: expected a finite number for POINTS, found '0.5x'"},
+      {head + "POINTS 1 double\n0 1e999 0\n", "line 6: expected a finite number for POINTS, found '1e999'"},
+      {head + "POINTS 1 bit\n0 1 0\n", "line 5: expected a points type (unsigned_char"},
+      {head + points + "POINT_DATA 5\n", "line 10: expected POINT_DATA 4 (the number of points), found 5"},
+      {head + points + "POINT_DATA 4\nNORMALS n float\n0 0 1\n",
+       "line 11: expected 12 values for NORMALS n within the 7 bytes left"},
+      {head + points + "POINT_DATA 4\nFIELD f 1\nCutThroughBone 1 999999999999 int\n",
+       "expected 999999999999 values for FIELD array CutThroughBone within"},
+      {"# vtk DataFile Version 4.2\nmesh\nASCII\nDATASET UNSTRUCTURED_GRID\n",
+       "line 4: expected DATASET POLYDATA, found DATASET UNSTRUCTURED_GRID"},
+      {"# vtk DataFile Version 6.0\nmesh\nASCII\n", "line 1: expected '# vtk DataFile Version x.y' of 1.0 to 5.1"},
+      {"# vtk DataFile Version 4.2\nmesh\nUTF8\n", "line 3: expected ASCII or BINARY, found 'UTF8'"},
+      {"# vtk DataFile Version 4.2\n" + std::string(300, 't') + "\nASCII\n",
+       "line 2: expected a title line of at most 256 characters, found 300"},
+      {"# vtk DataFile Version 5.1\nmesh\nASCII\nDATASET POLYDATA\n" + points +
+           "POLYGONS 3 6\nOFFSETS vtktypeint64\n0 3 2\nCONNECTIVITY vtktypeint64\n0 1 2 0 1 3\n",
+       "line 10 (POLYGONS): expected offsets rising from 0 to 6 (the connectivity's size), found 2 at offset 2"},
+      {"# vtk DataFile Version 5.1\nmesh\nASCII\nDATASET POLYDATA\n" + points + "POLYGONS 2 3\nOFFSETS float\n0 3\n",
+       "line 11: expected an offsets type vtktypeint64 or vtktypeint32, found 'float'"},
+  };
+  for (const auto& [text, expected] : bad) {
+    const std::string m = meshError(writeFile("bad.vtk", text));
+    EXPECT_TRUE(contains(m, "legacy VTK file '") && contains(m, "bad.vtk', ") && contains(m, expected))
+        << expected << "\n  got: " << m;
+  }
+
+  // Binary: big-endian, places by byte.
+  std::string binary = "# vtk DataFile Version 4.2\nmesh\nBINARY\nDATASET POLYDATA\nPOINTS 3 float\n";
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) appendBigEndian(binary, v);
+  binary += "\nPOLYGONS 1 4\n";
+  for (std::int32_t v : {3, 2, 1, 0}) appendBigEndian(binary, v);
+  binary += "\n";
+  const MeshFile tri = readMeshFile(writeFile("tri.vtk", binary));
+  ASSERT_EQ(tri.triangles.rows(), 1);
+  EXPECT_EQ(tri.triangles.row(0), Eigen::RowVector3i(2, 1, 0));
+  std::string m = meshError(writeFile("short.vtk", binary.substr(0, 90)));
+  EXPECT_TRUE(contains(m, "short.vtk', byte 71: expected 9 values for POINTS within the 19 bytes left")) << m;
+  std::string nan = binary;
+  nan.replace(71 + 4 * 4, 4, "\x7f\xc0\x00\x00", 4);
+  m = meshError(writeFile("nan.vtk", nan));
+  EXPECT_TRUE(contains(m, "nan.vtk', byte 87: expected finite coordinates, found nan in point 1 (0-based)")) << m;
+  std::string stray = binary;
+  stray.replace(stray.size() - 5, 4, "\x00\x00\x00\x03", 4);
+  m = meshError(writeFile("stray.vtk", stray));
+  EXPECT_TRUE(contains(m,
+                       "stray.vtk', byte 108 (POLYGONS, cell 0, 0-based): expected point indices from 0 to 2, "
+                       "found 3"))
+      << m;
+  m = meshError(writeFile("huge.vtk",
+                          "# vtk DataFile Version 4.2\nmesh\nBINARY\nDATASET POLYDATA\n"
+                          "POINTS 4000000000 float\n" +
+                              std::string(150, '\0')));
+  EXPECT_TRUE(contains(m, "byte 80: expected 12000000000 values for POINTS within the 150 bytes left")) << m;
+}
+
+// Prefixes of what VTK's writer wrote (ASCII and binary, both layouts; every 47th length, to stay
+// fast) read or are InputErrors.
+TEST_F(PointsTest, EveryTruncationOfALegacyVtkMeshIsAnInputErrorOrReads) {
+  const vtkSmartPointer<vtkPolyData> source = legacyTestMesh(false);
+  for (const int version :
+       {int{vtkPolyDataWriter::VTK_LEGACY_READER_VERSION_5_1}, int{vtkPolyDataWriter::VTK_LEGACY_READER_VERSION_4_2}}) {
+    for (const bool binary : {false, true}) {
+      vtkNew<vtkPolyDataWriter> writer;
+      writer->SetInputData(source);
+      writer->SetFileVersion(version);
+      if (binary) writer->SetFileTypeToBinary();
+      writer->WriteToOutputStringOn();
+      ASSERT_EQ(writer->Write(), 1);
+      const std::string whole = writer->GetOutputStdString();
+      EXPECT_NO_THROW(readMeshFile(writeFile("whole.vtk", whole)));
+      for (std::size_t size = 0; size < whole.size(); size += 47) {
+        try {
+          readMeshFile(writeFile("cut.vtk", whole.substr(0, size)));
+        } catch (const InputError&) {
+        }
+      }
+    }
   }
 }
 

@@ -1,8 +1,9 @@
-// Meshes (.stl, .obj, .vtp, .vtk) through VTK's readers, and .ply through the project's
-// own PLY reader (ply_reader.cpp: VTK 9.1's crashes on a short ASCII face record). VTK
-// reports problems through error events rather than exceptions, so an observer on the
-// reader, its executive and (for XML) its parser collects them, keeps them off stderr, and
-// we throw InputError with the first one.
+// Meshes (.stl, .obj, .vtp) through VTK's readers, and .ply and legacy .vtk through the
+// project's own readers (ply_reader.cpp, vtk_legacy_reader.cpp: VTK 9.1's crashed on a short
+// ASCII face record and on a malformed legacy header), whose meshes are handed to
+// meshFromPolyData as VTK's would be. VTK reports problems through error events rather than
+// exceptions, so an observer on the reader, its executive and (for XML) its parser collects
+// them, keeps them off stderr, and we throw InputError with the first one.
 #include <vtkVersion.h>
 #include <vtkAlgorithm.h>
 #include <vtkCommand.h>
@@ -12,7 +13,6 @@
 #include <vtkExecutive.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
-#include <vtkPolyDataReader.h>
 #include <vtkTriangleFilter.h>
 #include <vtkCellArray.h>
 #include <vtkPointData.h>
@@ -229,11 +229,6 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
     reader->SetFileName(path.c_str());
     return reader;
   }
-  if (ext == ".vtk") {
-    auto reader = vtkSmartPointer<vtkPolyDataReader>::New();
-    reader->SetFileName(path.c_str());
-    return reader;
-  }
   if (ext != ".vtp")
     throw InputError("mesh file " + quoted(path) + ": expected extension .vtp, .stl, .ply, .vtk or .obj, found '" +
                      path.extension().string() + "'");
@@ -275,6 +270,55 @@ vtkSmartPointer<vtkPolyData> plyPolyData(const std::filesystem::path& path) {
   return poly;
 }
 
+// A legacy .vtk mesh as VTK's polygons, its triangle strips cut into triangles after them
+// (meshFromPolyData triangulates polygons only), winding alternating along each strip as VTK's.
+vtkSmartPointer<vtkPolyData> legacyVtkPolyData(const std::filesystem::path& path) {
+  const VtkLegacyMesh mesh = readVtkLegacyMesh(path);
+  const Eigen::Index n = mesh.points.rows();
+  if (n == 0) throw InputError("mesh file " + quoted(path) + ": expected vertices, found none");
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  for (Eigen::Index i = 0; i < n; ++i) points->SetPoint(i, mesh.points(i, 0), mesh.points(i, 1), mesh.points(i, 2));
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  poly->SetPoints(points);
+  if (mesh.normals.rows() == n) {
+    vtkNew<vtkDoubleArray> normals;
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      normals->SetTuple3(i, mesh.normals(i, 0), mesh.normals(i, 1), mesh.normals(i, 2));
+    poly->GetPointData()->SetNormals(normals);
+  }
+  if (mesh.cut_through_bone.size() == static_cast<size_t>(n)) {
+    vtkNew<vtkDoubleArray> cut;
+    cut->SetName(kCutThroughBoneArray);
+    cut->SetNumberOfValues(n);
+    for (Eigen::Index i = 0; i < n; ++i) cut->SetValue(i, mesh.cut_through_bone[static_cast<size_t>(i)]);
+    poly->GetPointData()->AddArray(cut);
+  }
+  std::vector<std::int64_t> offsets = mesh.polygon_offsets, connectivity = mesh.polygon_connectivity;
+  for (size_t s = 0; s + 1 < mesh.strip_offsets.size(); ++s) {
+    const std::int64_t* ids = mesh.strip_connectivity.data() + mesh.strip_offsets[s];
+    const std::int64_t count = mesh.strip_offsets[s + 1] - mesh.strip_offsets[s];
+    for (std::int64_t j = 0; j + 2 < count; ++j) {
+      const bool odd = j % 2 == 1;
+      connectivity.insert(connectivity.end(), {ids[odd ? j + 1 : j], ids[odd ? j : j + 1], ids[j + 2]});
+      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+    }
+  }
+  vtkNew<vtkIdTypeArray> offset_array, connectivity_array;
+  offset_array->SetNumberOfValues(static_cast<vtkIdType>(offsets.size()));
+  for (size_t i = 0; i < offsets.size(); ++i) offset_array->SetValue(static_cast<vtkIdType>(i), offsets[i]);
+  connectivity_array->SetNumberOfValues(static_cast<vtkIdType>(connectivity.size()));
+  for (size_t i = 0; i < connectivity.size(); ++i)
+    connectivity_array->SetValue(static_cast<vtkIdType>(i), connectivity[i]);
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(offset_array, connectivity_array);
+  poly->SetPolys(polys);
+  return poly;
+}
+
 }  // namespace
 
 PointCloud readMeshVertices(const std::filesystem::path& path) {
@@ -292,7 +336,9 @@ MeshFile readMeshFile(const std::filesystem::path& path) {
   using detail::quoted;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file " + quoted(path) + " not found");
-  if (detail::lowercase(path.extension().string()) == ".ply") return meshFromPolyData(detail::plyPolyData(path));
+  const std::string ext = detail::lowercase(path.extension().string());
+  if (ext == ".ply") return meshFromPolyData(detail::plyPolyData(path));
+  if (ext == ".vtk") return meshFromPolyData(detail::legacyVtkPolyData(path));
   vtkNew<detail::ErrorCollector> errors;
   vtkSmartPointer<vtkAlgorithm> reader = detail::makeReader(path, errors);
   for (vtkObject* source : {static_cast<vtkObject*>(reader), static_cast<vtkObject*>(reader->GetExecutive())}) {

@@ -20,6 +20,17 @@ struct PlyMesh {
   std::vector<std::int64_t> face_offsets{0}, face_indices;
 };
 PlyMesh readPlyMesh(const std::filesystem::path& path);
+/// A legacy VTK POLYDATA mesh (.vtk), by the project's reader (see vtk_legacy_reader.cpp for why
+/// not vtkPolyDataReader): its points (#P x 3), point normals (#P x 3, or 0 rows), the point array
+/// CutThroughBone (#P values, or empty), and its polygons and triangle strips, cell i's point
+/// indices (0-based, each a point the file has) at connectivity[offsets[i] .. offsets[i + 1]).
+struct VtkLegacyMesh {
+  Eigen::MatrixX3d points, normals;
+  std::vector<std::int64_t> polygon_offsets{0}, polygon_connectivity;
+  std::vector<std::int64_t> strip_offsets{0}, strip_connectivity;
+  std::vector<double> cut_through_bone;
+};
+VtkLegacyMesh readVtkLegacyMesh(const std::filesystem::path& path);
 /// Delimited text: .csv, .xyz, .txt.
 PointCloud readTable(const std::filesystem::path& path);
 /// Vertices (and point normals, if any) of .stl, .obj, .vtp meshes through VTK.
