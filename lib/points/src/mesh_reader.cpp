@@ -239,73 +239,33 @@ vtkSmartPointer<vtkAlgorithm> makeReader(const std::filesystem::path& path, vtkC
   return reader;
 }
 
-// A PLY mesh as VTK's polygons, for meshFromPolyData to triangulate as it does every mesh's.
-vtkSmartPointer<vtkPolyData> plyPolyData(const std::filesystem::path& path) {
-  const PlyMesh ply = readPlyMesh(path);
-  const Eigen::Index n = ply.cloud.positions.rows();
+// Vertices, their normals (none: 0 rows) and a per-vertex cut-through-bone mark (none:
+// empty), and polygons as offsets into their vertex ids: a vtkPolyData for meshFromPolyData,
+// which triangulates every mesh's polygons alike.
+vtkSmartPointer<vtkPolyData> polyDataOf(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3d& normals,
+                                        const std::vector<double>& cut_through_bone,
+                                        const std::vector<std::int64_t>& offsets,
+                                        const std::vector<std::int64_t>& connectivity) {
+  const Eigen::Index n = vertices.rows();
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    points->SetPoint(i, ply.cloud.positions(i, 0), ply.cloud.positions(i, 1), ply.cloud.positions(i, 2));
+  for (Eigen::Index i = 0; i < n; ++i) points->SetPoint(i, vertices(i, 0), vertices(i, 1), vertices(i, 2));
   auto poly = vtkSmartPointer<vtkPolyData>::New();
   poly->SetPoints(points);
-  if (ply.cloud.normals.rows() == n) {
-    vtkNew<vtkDoubleArray> normals;
-    normals->SetNumberOfComponents(3);
-    normals->SetNumberOfTuples(n);
-    for (Eigen::Index i = 0; i < n; ++i)
-      normals->SetTuple3(i, ply.cloud.normals(i, 0), ply.cloud.normals(i, 1), ply.cloud.normals(i, 2));
-    poly->GetPointData()->SetNormals(normals);
+  if (normals.rows() == n) {
+    vtkNew<vtkDoubleArray> array;
+    array->SetNumberOfComponents(3);
+    array->SetNumberOfTuples(n);
+    for (Eigen::Index i = 0; i < n; ++i) array->SetTuple3(i, normals(i, 0), normals(i, 1), normals(i, 2));
+    poly->GetPointData()->SetNormals(array);
   }
-  vtkNew<vtkIdTypeArray> offsets, connectivity;
-  offsets->SetNumberOfValues(static_cast<vtkIdType>(ply.face_offsets.size()));
-  for (size_t i = 0; i < ply.face_offsets.size(); ++i) offsets->SetValue(static_cast<vtkIdType>(i), ply.face_offsets[i]);
-  connectivity->SetNumberOfValues(static_cast<vtkIdType>(ply.face_indices.size()));
-  for (size_t i = 0; i < ply.face_indices.size(); ++i)
-    connectivity->SetValue(static_cast<vtkIdType>(i), ply.face_indices[i]);
-  vtkNew<vtkCellArray> polys;
-  polys->SetData(offsets, connectivity);
-  poly->SetPolys(polys);
-  return poly;
-}
-
-// A legacy .vtk mesh as VTK's polygons, its triangle strips cut into triangles after them
-// (meshFromPolyData triangulates polygons only), winding alternating along each strip as VTK's.
-vtkSmartPointer<vtkPolyData> legacyVtkPolyData(const std::filesystem::path& path) {
-  const VtkLegacyMesh mesh = readVtkLegacyMesh(path);
-  const Eigen::Index n = mesh.points.rows();
-  if (n == 0) throw InputError("mesh file " + quoted(path) + ": expected vertices, found none");
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(n);
-  for (Eigen::Index i = 0; i < n; ++i) points->SetPoint(i, mesh.points(i, 0), mesh.points(i, 1), mesh.points(i, 2));
-  auto poly = vtkSmartPointer<vtkPolyData>::New();
-  poly->SetPoints(points);
-  if (mesh.normals.rows() == n) {
-    vtkNew<vtkDoubleArray> normals;
-    normals->SetNumberOfComponents(3);
-    normals->SetNumberOfTuples(n);
-    for (Eigen::Index i = 0; i < n; ++i)
-      normals->SetTuple3(i, mesh.normals(i, 0), mesh.normals(i, 1), mesh.normals(i, 2));
-    poly->GetPointData()->SetNormals(normals);
-  }
-  if (mesh.cut_through_bone.size() == static_cast<size_t>(n)) {
+  if (cut_through_bone.size() == static_cast<size_t>(n)) {
     vtkNew<vtkDoubleArray> cut;
     cut->SetName(kCutThroughBoneArray);
     cut->SetNumberOfValues(n);
-    for (Eigen::Index i = 0; i < n; ++i) cut->SetValue(i, mesh.cut_through_bone[static_cast<size_t>(i)]);
+    for (Eigen::Index i = 0; i < n; ++i) cut->SetValue(i, cut_through_bone[static_cast<size_t>(i)]);
     poly->GetPointData()->AddArray(cut);
-  }
-  std::vector<std::int64_t> offsets = mesh.polygon_offsets, connectivity = mesh.polygon_connectivity;
-  for (size_t s = 0; s + 1 < mesh.strip_offsets.size(); ++s) {
-    const std::int64_t* ids = mesh.strip_connectivity.data() + mesh.strip_offsets[s];
-    const std::int64_t count = mesh.strip_offsets[s + 1] - mesh.strip_offsets[s];
-    for (std::int64_t j = 0; j + 2 < count; ++j) {
-      const bool odd = j % 2 == 1;
-      connectivity.insert(connectivity.end(), {ids[odd ? j + 1 : j], ids[odd ? j : j + 1], ids[j + 2]});
-      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
-    }
   }
   vtkNew<vtkIdTypeArray> offset_array, connectivity_array;
   offset_array->SetNumberOfValues(static_cast<vtkIdType>(offsets.size()));
@@ -317,6 +277,29 @@ vtkSmartPointer<vtkPolyData> legacyVtkPolyData(const std::filesystem::path& path
   polys->SetData(offset_array, connectivity_array);
   poly->SetPolys(polys);
   return poly;
+}
+
+vtkSmartPointer<vtkPolyData> plyPolyData(const std::filesystem::path& path) {
+  const PlyMesh ply = readPlyMesh(path);
+  return polyDataOf(ply.cloud.positions, ply.cloud.normals, {}, ply.face_offsets, ply.face_indices);
+}
+
+// A legacy .vtk mesh, its triangle strips cut into triangles after its polygons
+// (meshFromPolyData triangulates polygons only), winding alternating along each strip as VTK's.
+vtkSmartPointer<vtkPolyData> legacyVtkPolyData(const std::filesystem::path& path) {
+  const VtkLegacyMesh mesh = readVtkLegacyMesh(path);
+  if (mesh.points.rows() == 0) throw InputError("mesh file " + quoted(path) + ": expected vertices, found none");
+  std::vector<std::int64_t> offsets = mesh.polygon_offsets, connectivity = mesh.polygon_connectivity;
+  for (size_t s = 0; s + 1 < mesh.strip_offsets.size(); ++s) {
+    const std::int64_t* ids = mesh.strip_connectivity.data() + mesh.strip_offsets[s];
+    const std::int64_t count = mesh.strip_offsets[s + 1] - mesh.strip_offsets[s];
+    for (std::int64_t j = 0; j + 2 < count; ++j) {
+      const bool odd = j % 2 == 1;
+      connectivity.insert(connectivity.end(), {ids[odd ? j + 1 : j], ids[odd ? j : j + 1], ids[j + 2]});
+      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+    }
+  }
+  return polyDataOf(mesh.points, mesh.normals, mesh.cut_through_bone, offsets, connectivity);
 }
 
 }  // namespace
