@@ -25,6 +25,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <sstream>
@@ -70,10 +71,10 @@ class PointsTest : public ::testing::Test {
   fs::path dir_;
 };
 
-// The InputError message of readPoints(path); fails the test if anything else happens.
-std::string readError(const fs::path& path) {
+// The InputError message of read(path); fails the test if anything else happens.
+std::string inputErrorOf(const fs::path& path, const std::function<void(const fs::path&)>& read) {
   try {
-    readPoints(path);
+    read(path);
   } catch (const InputError& e) {
     EXPECT_EQ(e.code(), articula::ExitCode::InvalidInput);
     return e.what();
@@ -83,6 +84,12 @@ std::string readError(const fs::path& path) {
   }
   ADD_FAILURE() << "expected InputError reading " << path << ", nothing thrown";
   return {};
+}
+std::string readError(const fs::path& path) {
+  return inputErrorOf(path, [](const fs::path& p) { readPoints(p); });
+}
+std::string meshError(const fs::path& path) {
+  return inputErrorOf(path, [](const fs::path& p) { readMeshFile(p); });
 }
 
 std::string fittableError(const PointCloud& cloud, int min_points) {
@@ -672,12 +679,8 @@ TEST_F(PointsTest, ReadsPlyMeshFacesAndRefusesShortOrStrayFaces) {
       {"7 4 0 1 2 3\n0 3 0 -1 4\n", "(face 1, 0-based): expected vertex indices from 0 to 4, found -1"},
       {"7 4 0 1 2 3\n", "expected 2 face records, found the end of the file after 1"}};
   for (const auto& [faces, expected] : bad) {
-    try {
-      readMeshFile(writeFile("bad.ply", header + vertices + faces));
-      ADD_FAILURE() << "nothing thrown for " << faces;
-    } catch (const InputError& e) {
-      EXPECT_TRUE(contains(e.what(), "bad.ply") && contains(e.what(), expected)) << e.what();
-    }
+    const std::string m = meshError(writeFile("bad.ply", header + vertices + faces));
+    EXPECT_TRUE(contains(m, "bad.ply") && contains(m, expected)) << m;
   }
   // Binary, big-endian, the faces' list named vertex_index.
   std::string binary = "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -689,30 +692,12 @@ TEST_F(PointsTest, ReadsPlyMeshFacesAndRefusesShortOrStrayFaces) {
   ASSERT_EQ(tri.triangles.rows(), 1);
   EXPECT_EQ(tri.triangles.row(0), Eigen::RowVector3i(2, 1, 0));
   appendBigEndian(binary.erase(binary.size() - 4), std::uint32_t{3});
-  try {
-    readMeshFile(writeFile("stray.ply", binary));
-    ADD_FAILURE() << "nothing thrown for a face naming vertex 3 of 3";
-  } catch (const InputError& e) {
-    EXPECT_TRUE(contains(e.what(), "binary data (face 0, 0-based): expected vertex indices from 0 to 2, found 3"))
-        << e.what();
-  }
+  const std::string m = meshError(writeFile("stray.ply", binary));
+  EXPECT_TRUE(contains(m, "binary data (face 0, 0-based): expected vertex indices from 0 to 2, found 3")) << m;
 }
 
 // ---- legacy .vtk meshes ---------------------------------------------------------------------------------
 
-// The InputError message of readMeshFile(path); fails the test if anything else happens.
-std::string meshError(const fs::path& path) {
-  try {
-    readMeshFile(path);
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected InputError reading " << path << ", nothing thrown";
-  return {};
-}
 
 // Six points, a quad and a triangle, a triangle strip, float point normals (with component
 // names, so VTK writes METADATA after them), CutThroughBone as the active scalars or as a
