@@ -446,8 +446,8 @@ PointCloud readBinary(std::istream& in, const Header& header, std::size_t vertex
 
 namespace {
 
-// The vertices (and, given `faces`, the face lists) of a PLY file.
-PointCloud readPlyFile(const std::filesystem::path& path, bool with_faces, FaceLists& faces) {
+// The vertices of a PLY file, and its face lists into `faces` unless null (point files).
+PointCloud readPlyFile(const std::filesystem::path& path, FaceLists* faces) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("cannot open point file " + quoted(path) + " for reading");
   const Header header = readHeader(in, path);
@@ -460,41 +460,39 @@ PointCloud readPlyFile(const std::filesystem::path& path, bool with_faces, FaceL
   const VertexLayout layout = vertexLayout(*vertex, path);
   if (vertex->count == 0) throw InputError("point file " + quoted(path) + ": expected points, found 0 vertices");
 
-  FaceLists* reading_faces = nullptr;
   const auto face = std::find_if(header.elements.begin(), header.elements.end(),
                                  [](const Element& e) { return e.name == "face"; });
-  if (with_faces && face != header.elements.end()) {
+  if (faces && face == header.elements.end()) faces = nullptr;  // a point cloud: vertices only
+  if (faces) {
     const auto list = std::find_if(face->properties.begin(), face->properties.end(), [](const Property& p) {
       return p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
     });
     if (list == face->properties.end())
       throw InputError("PLY header of " + quoted(path) +
                        ": expected the face element to list 'vertex_indices' (or 'vertex_index'), found no such list");
-    faces.element = static_cast<std::size_t>(face - header.elements.begin());
-    faces.property = static_cast<std::size_t>(list - face->properties.begin());
-    faces.vertex_count = vertex->count;
-    reading_faces = &faces;
+    faces->element = static_cast<std::size_t>(face - header.elements.begin());
+    faces->property = static_cast<std::size_t>(list - face->properties.begin());
+    faces->vertex_count = vertex->count;
   }
 
   const auto data_start = static_cast<std::uintmax_t>(in.tellg());
   const std::uintmax_t file_bytes = std::filesystem::file_size(path);
   const std::uintmax_t data_bytes = file_bytes > data_start ? file_bytes - data_start : 0;
   return header.format == Format::Ascii
-             ? readAscii(in, header, vertex_index, layout, path, data_bytes, reading_faces)
-             : readBinary(in, header, vertex_index, layout, path, data_bytes, reading_faces);
+             ? readAscii(in, header, vertex_index, layout, path, data_bytes, faces)
+             : readBinary(in, header, vertex_index, layout, path, data_bytes, faces);
 }
 
 }  // namespace
 
 PointCloud readPly(const std::filesystem::path& path) {
-  FaceLists unused;
-  return readPlyFile(path, false, unused);
+  return readPlyFile(path, nullptr);
 }
 
 PlyMesh readPlyMesh(const std::filesystem::path& path) {
   FaceLists faces;
   PlyMesh mesh;
-  mesh.cloud = readPlyFile(path, true, faces);
+  mesh.cloud = readPlyFile(path, &faces);
   mesh.face_offsets = std::move(faces.offsets);
   mesh.face_indices = std::move(faces.indices);
   return mesh;
