@@ -553,7 +553,7 @@ void placeOnCortexModel(const TriangleMesh& mesh, const std::vector<std::vector<
       const size_t band_stride = std::max<size_t>(1, band.size() / kMoreLinesWithinSlices);
       for (size_t j = 0; j < band.size(); j += band_stride) band_lines.push_back(lineAt(on_edge[band[j]], false));
     }
-    spread = imaging::estimatePointSpread(lines, options.threads, band_lines);
+    spread = imaging::estimatePointSpread(lines, options.threads, band_lines, s.ct_noise_hu);
     if (!spread.found) {
       s.cortex_model_note = "the CT's point-spread could not be estimated from " + std::to_string(spread.profiles) +
                             " edges; the edges are the steepest falls";

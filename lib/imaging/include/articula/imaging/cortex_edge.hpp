@@ -212,8 +212,11 @@ double curvatureShiftMm(const LineVoxels& line, const PointSpread& spread);
 /// with it (held_across). `more_within_slices`: further lines within long
 /// slices that join those of `lines` there for the width within them and
 /// the tissue held across them, and take part in nothing else.
+/// `noise_hu`: the CT's noise voxel to voxel (noiseHu); the width within the
+/// slices leans under noise, and where it is given the lean is measured by
+/// remaking the lines from their fits with that noise and taken off.
 PointSpread estimatePointSpread(const std::vector<LineVoxels>& lines, int threads = 1,
-                                const std::vector<LineVoxels>& more_within_slices = {});
+                                const std::vector<LineVoxels>& more_within_slices = {}, double noise_hu = 0);
 
 /// Lines whose slice share is below this lie within the slices: across
 /// them a line sees the in-plane voxel's extent and blur only.
